@@ -1,0 +1,21 @@
+"""Exact sensor-planning geometry after Briggs & Donald, "Robust Geometric
+Algorithms for Sensor Planning": complete and partial visibility regions of a
+polygonal target (stationary, translating or rotating through a region), with
+uncertainty in sensor placement and aim, and recognizability regions that avoid
+confusing the goal G with the failure region H.
+
+All functions take a :class:`Scene` and return shapely geometries in world
+coordinates; angles are radians.  The package does not depend on Gymnasium.
+"""
+
+from .complete import complete_region
+from .partial import partial_region
+from .scene import Scene, SceneError, SensorSpec
+
+__all__ = [
+    "Scene",
+    "SceneError",
+    "SensorSpec",
+    "complete_region",
+    "partial_region",
+]

@@ -1,0 +1,200 @@
+"""Shared helpers of the region algorithms: the target specification, convex
+hulls and Minkowski sums, the cached visibility domain of a scene, and the
+positional-uncertainty shrink of paper section 4."""
+
+from __future__ import annotations
+
+import math
+import weakref
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+import shapely
+from shapely import affinity
+
+from ._vis import Domain, domain_from_geometry
+
+if TYPE_CHECKING:  # pragma: no cover
+    from .scene import Scene
+
+#: Polygonal arcs (disc buffers) use this many segments per quarter circle.
+QUAD_SEGS = 16
+#: Radius factor making a polygonal buffer contain the exact disc buffer.
+OUTER = 1.0 / math.cos(math.pi / (4 * QUAD_SEGS))
+
+_DOMAINS: "weakref.WeakKeyDictionary[Scene, Domain]" = weakref.WeakKeyDictionary()
+
+
+def scene_domain(scene: Scene) -> Domain:
+    """The free space of ``scene`` as a visibility domain (cached per scene)."""
+    dom = _DOMAINS.get(scene)
+    if dom is None:
+        dom = domain_from_geometry(scene.free_space)
+        _DOMAINS[scene] = dom
+    return dom
+
+
+def hull_points(geom: shapely.Geometry) -> np.ndarray:
+    """Vertices of the convex hull of ``geom`` as an (n, 2) array, counter-clockwise."""
+    hull = shapely.convex_hull(geom)
+    if hull.geom_type == "Polygon":
+        hull = shapely.orient_polygons(hull, exterior_cw=False)
+        return np.asarray(hull.exterior.coords)[:-1, :2]
+    return np.asarray(shapely.get_coordinates(hull))
+
+
+def minkowski_sum(a: shapely.Geometry, b: shapely.Geometry) -> shapely.Geometry:
+    """Exact Minkowski sum of two polygons (or a polygon and a point).
+
+    Both are split into triangles (constrained Delaunay); the sum is the union of
+    the convex hulls of the pairwise sums of triangle vertices.
+    """
+    if b.geom_type == "Point":
+        return affinity.translate(a, b.x, b.y)
+    if a.geom_type == "Point":
+        return affinity.translate(b, a.x, a.y)
+    ta = _triangles(a)
+    tb = _triangles(b)
+    sums = (ta[:, None, :, None, :] + tb[None, :, None, :, :]).reshape(len(ta) * len(tb), 9, 2)
+    hulls = shapely.convex_hull(shapely.multipoints(sums))
+    return shapely.union_all(hulls)
+
+
+def _triangles(p: shapely.Geometry) -> np.ndarray:
+    if shapely.equals(p, shapely.convex_hull(p)):
+        c = np.asarray(p.exterior.coords)[:-1]
+        return np.stack([np.repeat(c[:1], len(c) - 2, 0), c[1:-1], c[2:]], axis=1)
+    tri = shapely.constrained_delaunay_triangles(p)
+    return np.asarray([np.asarray(t.exterior.coords)[:3] for t in tri.geoms])
+
+
+@dataclass(frozen=True)
+class TargetSpec:
+    """What must be seen: the (swept) target area and its convex hull.
+
+    ``area`` is the set the target can occupy (sensor placements must avoid it);
+    ``hull_pts`` the vertices of its convex hull, with ``radius`` > 0 when every
+    hull vertex stands for a disc of that radius (rotating target); ``center`` a
+    point inside the hull.  ``pose`` is set for a stationary target.
+    """
+
+    area: shapely.Geometry
+    hull_pts: np.ndarray
+    radius: float
+    center: np.ndarray
+    pose: tuple[float, float, float] | None
+    label: str
+
+    @property
+    def hull(self) -> shapely.Geometry:
+        h = shapely.convex_hull(shapely.multipoints(self.hull_pts))
+        if self.radius > 0:
+            h = h.buffer(self.radius * OUTER, quad_segs=QUAD_SEGS)
+        return h
+
+
+def target_spec(
+    scene: Scene,
+    target_at: tuple[float, float, float] | None,
+    target_in: str | shapely.Geometry | None,
+    theta: float | None,
+) -> TargetSpec:
+    """Resolve the ``target_at`` / ``target_in`` / ``theta`` arguments.
+
+    Raises ``ValueError`` for contradictory or malformed arguments and
+    ``SceneError`` when the paper's assumption (no obstacle or wall meets the
+    convex hull of the swept target) fails for this query.
+    """
+    if (target_at is None) == (target_in is None):
+        raise ValueError("give exactly one of target_at=(x, y, theta) or target_in=<region>")
+    if target_at is not None:
+        try:
+            x, y, th = (float(v) for v in target_at)
+        except (TypeError, ValueError):
+            raise ValueError(f"target_at must be (x, y, theta) numbers, got {target_at!r}") from None
+        if not all(math.isfinite(v) for v in (x, y, th)):
+            raise ValueError(f"target_at must be finite, got {target_at!r}")
+        if theta not in (0.0, None) and theta != th:
+            raise ValueError("with target_at the orientation is target_at[2]; do not pass theta")
+        area = scene.target_at(x, y, th)
+        pts = hull_points(area)
+        spec = TargetSpec(area, pts, 0.0, np.asarray(area.centroid.coords[0]), (x, y, th),
+                          f"target at ({x:g}, {y:g}, {th:g})")
+    else:
+        region = _region(scene, target_in)
+        label = f"target in {target_in}" if isinstance(target_in, str) else "target in region"
+        if theta is None:
+            r = float(scene.target_radius)
+            pts = hull_points(region)
+            area = region.buffer(r * OUTER, quad_segs=QUAD_SEGS)
+            center = np.asarray(shapely.convex_hull(region).centroid.coords[0]) if len(pts) > 2 \
+                else pts.mean(axis=0)
+            spec = TargetSpec(area, pts, r, center, None, label + " (any orientation)")
+        else:
+            th = float(theta)
+            if not math.isfinite(th):
+                raise ValueError(f"theta must be finite or None, got {theta!r}")
+            a = scene.target_at(0.0, 0.0, th)
+            area = minkowski_sum(a, region)
+            pts = hull_points(area)
+            c = shapely.convex_hull(area).centroid
+            spec = TargetSpec(area, pts, 0.0, np.asarray(c.coords[0]), None,
+                              label + f" (orientation {th:g})")
+    scene.check_clear(spec.hull, spec.label)
+    return spec
+
+
+def _region(scene: Scene, which: str | shapely.Geometry) -> shapely.Geometry:
+    if isinstance(which, str):
+        if which not in ("goal", "failure"):
+            raise ValueError(f"target_in must be 'goal', 'failure' or a shapely Polygon/Point, got {which!r}")
+        return scene.region(which)
+    if not isinstance(which, shapely.Geometry) or which.geom_type not in ("Polygon", "Point"):
+        raise ValueError(f"target_in must be 'goal', 'failure' or a shapely Polygon/Point, got {which!r}")
+    if which.is_empty or not which.is_valid:
+        raise ValueError(f"target_in region is empty or invalid: {shapely.is_valid_reason(which)}")
+    if not scene.free_space.covers(which):
+        raise ValueError("target_in region is not inside the free space (bounds minus obstacles)")
+    return which
+
+
+def check_eps(name: str, value: float) -> float:
+    """Validate a non-negative finite uncertainty bound and return it as float."""
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a number, got {value!r}") from None
+    if not math.isfinite(v) or v < 0:
+        raise ValueError(f"{name} must be finite and >= 0, got {value!r}")
+    return v
+
+
+def shrink_for_position(region: shapely.Geometry, allowed: shapely.Geometry, eps_pos: float) -> shapely.Geometry:
+    """Paper section 4, positional uncertainty: grow the shadows by the eps-disc.
+
+    ``allowed`` is the placement space (free space minus the target area);
+    shadows are ``allowed - region``.  The result keeps the points of ``region``
+    whose whole eps-disc, within ``allowed``, lies in ``region``.  The disc is a
+    polygon circumscribing the true disc, so the result is conservative: it lies
+    inside the exact region, within ``eps_pos * (1/cos(pi/64) - 1)`` of it.
+    """
+    if eps_pos <= 0 or region.is_empty:
+        return region
+    shadows = shapely.difference(allowed, region)
+    grown = shapely.buffer(shadows, eps_pos * OUTER, quad_segs=QUAD_SEGS)
+    return _polygonal(shapely.difference(region, grown))
+
+
+def _polygonal(g: shapely.Geometry) -> shapely.Geometry:
+    """Drop lower-dimensional debris from a boolean result."""
+    if g.geom_type in ("Polygon", "MultiPolygon") or g.is_empty:
+        return g
+    parts = shapely.get_parts(g)
+    parts = parts[np.isin(shapely.get_type_id(parts), (3, 6))]
+    if len(parts) == 0:
+        return shapely.Polygon()
+    return shapely.union_all(parts)
+
+
+polygonal = _polygonal
