@@ -10,6 +10,7 @@ coordinates; angles are radians.  The package does not depend on Gymnasium.
 
 from .complete import complete_region
 from .partial import partial_region
+from .recognize import overlap_segments, recognizable_region
 from .scene import Scene, SceneError, SensorSpec
 
 __all__ = [
@@ -17,5 +18,7 @@ __all__ = [
     "SceneError",
     "SensorSpec",
     "complete_region",
+    "overlap_segments",
     "partial_region",
+    "recognizable_region",
 ]
