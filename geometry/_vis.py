@@ -24,7 +24,7 @@ import shapely
 
 TAU = 2.0 * np.pi
 
-__all__ = ["Domain", "Gaps", "gaps_from", "polygon_from_gaps", "visibility_polygon"]
+__all__ = ["Domain", "Gaps", "gaps_from", "gaps_many", "polygon_from_gaps", "visibility_polygon"]
 
 
 @dataclass(frozen=True)
@@ -193,73 +193,110 @@ def gaps_from(
     ----------
     q : viewpoint (x, y), world frame.
     sector : optional ``(start, width)`` in radians; only directions inside it are
-        resolved, the others are reported as blocked (``seg == -1``).
+        resolved (the gaps cover exactly the sector).
     extra : additional critical directions (radians) to split gaps at.
     wedge : ``True`` to detect whether ``q`` is a domain vertex and block the
-        directions that point into the boundary there; an explicit
-        ``(start, width)`` free wedge; or ``None``/``False`` for an interior point.
+        directions that point into the boundary there (``seg == -1``); an
+        explicit ``(start, width)`` free wedge; or ``None``/``False`` for an
+        interior point.
     """
-    q = np.asarray(q, dtype=float)
-    tol = 1e-12 * dom.scale
+    q = np.asarray(q, dtype=float)[None, :]
     if wedge is True:
-        wedge = local_wedge(dom, q)
+        w = local_wedge(dom, q[0])
     elif wedge is False:
-        wedge = None
-    d = dom.vert - q
-    far = np.abs(d).max(axis=1) > tol
-    ang = [np.arctan2(d[far, 1], d[far, 0])]
-    if extra is not None:
-        ang.append(np.asarray(extra, dtype=float).ravel())
-    if wedge is not None:
-        ang.append(np.array([wedge[0], wedge[0] + wedge[1]]))
-    if sector is not None:
-        ang.append(np.array([sector[0], sector[0] + sector[1]]))
-    ang = np.concatenate(ang) % TAU
-    if sector is not None:
-        rel = (ang - sector[0]) % TAU
-        eps = 1e-13
-        inside = (rel <= sector[1] + eps) | (rel >= TAU - eps)
-        ang = ang[inside]
-        base = sector[0] % TAU
-        ang = np.sort(base + (ang - base) % TAU)
-        # make the sector's end exact
-        ang = np.unique(np.concatenate([[base], ang[ang <= base + sector[1]], [base + sector[1]]]))
-        lo, hi = ang[:-1], ang[1:]
+        w = None
     else:
-        ang = np.unique(ang)
-        lo = ang
-        hi = np.append(ang[1:], ang[0] + TAU)
-    keep = (hi - lo) > 1e-13
-    lo, hi = lo[keep], hi[keep]
+        w = wedge
+    ex = None if extra is None else np.asarray(extra, dtype=float).reshape(1, -1)
+    return gaps_many(
+        dom,
+        q,
+        sectors=None if sector is None else np.asarray([sector], dtype=float),
+        wedges=None if w is None else np.asarray([w], dtype=float),
+        extra=ex,
+    )[0]
+
+
+def gaps_many(
+    dom: Domain,
+    q: np.ndarray,
+    *,
+    sectors: np.ndarray | None = None,
+    wedges: np.ndarray | None = None,
+    extra: np.ndarray | None = None,
+) -> list[Gaps]:
+    """:func:`gaps_from` for many viewpoints at once (one vectorised ray cast).
+
+    ``q`` is (n, 2); ``sectors`` and ``wedges`` are (n, 2) arrays of
+    ``(start, width)`` (a NaN row means no restriction); ``extra`` is (n, k)
+    extra critical directions (NaN entries ignored).
+    """
+    n = len(q)
+    tol = 1e-12 * dom.scale
+    start = np.zeros(n)
+    width = np.full(n, TAU)
+    if sectors is not None:
+        has = ~np.isnan(sectors[:, 0])
+        start[has] = sectors[has, 0]
+        width[has] = np.minimum(sectors[has, 1], TAU)
+    d = dom.vert[None, :, :] - q[:, None, :]
+    cols = [np.where(np.abs(d).max(axis=2) > tol, np.arctan2(d[..., 1], d[..., 0]), np.nan)]
+    if extra is not None:
+        cols.append(extra)
+    if wedges is not None:
+        cols.append(np.stack([wedges[:, 0], wedges[:, 0] + wedges[:, 1]], axis=1))
+    ang = np.concatenate(cols, axis=1)
+    rel = (ang - start[:, None]) % TAU
+    rel = np.where(np.isnan(rel) | (rel >= width[:, None]) | (rel <= 0.0), np.inf, rel)
+    rel = np.sort(np.concatenate([np.zeros((n, 1)), rel, width[:, None]], axis=1), axis=1)
+    lo_r, hi_r = rel[:, :-1], rel[:, 1:]
+    with np.errstate(invalid="ignore"):
+        good = np.isfinite(hi_r) & (hi_r - lo_r > 1e-13)
+    owner, col = np.nonzero(good)
+    lo = start[owner] + lo_r[owner, col]
+    hi = start[owner] + hi_r[owner, col]
     mid = 0.5 * (lo + hi)
     open_ = np.ones(len(mid), dtype=bool)
-    if wedge is not None:
-        rel = (mid - wedge[0]) % TAU
-        open_ &= rel < wedge[1]
+    if wedges is not None:
+        w0 = wedges[owner, 0]
+        inw = ((mid - w0) % TAU) < wedges[owner, 1]
+        open_ &= np.isnan(w0) | inw
+    qo = q[owner]
     seg = np.full(len(mid), -1, dtype=np.int64)
-    if open_.any():
-        seg[open_] = _first_hits(dom, q, mid[open_])
-    p0 = np.broadcast_to(q, (len(mid), 2)).copy()
-    p1 = p0.copy()
+    idx = np.flatnonzero(open_)
+    for c in range(0, len(idx), 2048):
+        part = idx[c : c + 2048]
+        seg[part] = _first_hits(dom, qo[part], mid[part])
+    p0 = qo.copy()
+    p1 = qo.copy()
     ok = seg >= 0
     if ok.any():
-        s = dom.seg[seg[ok]]
-        p0[ok] = _ray_line(q, lo[ok], s)
-        p1[ok] = _ray_line(q, hi[ok], s)
-    return Gaps(q=q, lo=lo, hi=hi, seg=seg, p0=p0, p1=p1)
+        sg = dom.seg[seg[ok]]
+        p0[ok] = _ray_line(qo[ok], lo[ok], sg)
+        p1[ok] = _ray_line(qo[ok], hi[ok], sg)
+    cuts = np.searchsorted(owner, np.arange(1, n))
+    return [
+        Gaps(q=q[i], lo=l_, hi=h_, seg=s_, p0=a_, p1=b_)
+        for i, (l_, h_, s_, a_, b_) in enumerate(
+            zip(*(np.split(x, cuts) for x in (lo, hi, seg, p0, p1)))
+        )
+    ]
 
 
 def _first_hits(dom: Domain, q: np.ndarray, phi: np.ndarray) -> np.ndarray:
-    """Index of the first segment hit by rays from ``q`` at angles ``phi``."""
+    """Index of the first segment hit by rays from ``q`` (one point or one per
+    ray) at angles ``phi``."""
+    q = np.broadcast_to(q, (len(phi), 2))
     dx = np.cos(phi)[:, None]
     dy = np.sin(phi)[:, None]
-    a = dom.seg[None, :, :2] - q
+    ax = dom.seg[None, :, 0] - q[:, 0:1]
+    ay = dom.seg[None, :, 1] - q[:, 1:2]
     ex = (dom.seg[:, 2] - dom.seg[:, 0])[None, :]
     ey = (dom.seg[:, 3] - dom.seg[:, 1])[None, :]
     den = dx * ey - dy * ex
     with np.errstate(divide="ignore", invalid="ignore"):
-        t = (a[..., 0] * ey - a[..., 1] * ex) / den
-        s = (a[..., 0] * dy - a[..., 1] * dx) / den
+        t = (ax * ey - ay * ex) / den
+        s = (ax * dy - ay * dx) / den
     tmin = 1e-11 * dom.scale
     valid = (t > tmin) & (s >= -1e-12) & (s <= 1.0 + 1e-12)
     t = np.where(valid, t, np.inf)
@@ -279,26 +316,34 @@ def _ray_line(q: np.ndarray, phi: np.ndarray, s: np.ndarray) -> np.ndarray:
     return q + d * t[:, None]
 
 
-def polygon_from_gaps(g: Gaps, mask: np.ndarray | None = None) -> shapely.Polygon:
-    """The star polygon swept by the gaps (those in ``mask``, all by default).
-
-    Blocked or masked-out gaps contribute the viewpoint itself, so a masked
-    result is a fan of triangles anchored at ``q``.
-    """
-    use = g.seg >= 0
-    if mask is not None:
-        use = use & mask
-    if not use.any():
+def polygon_from_gaps(g: Gaps) -> shapely.Geometry:
+    """The star polygon swept by the open gaps of ``g`` (blocked gaps contribute
+    the viewpoint itself)."""
+    if not (g.seg >= 0).any():
         return shapely.Polygon()
-    p0 = np.where(use[:, None], g.p0, g.q)
-    p1 = np.where(use[:, None], g.p1, g.q)
-    pts = np.empty((2 * len(p0), 2))
-    pts[0::2] = p0
-    pts[1::2] = p1
+    pts = np.empty((2 * len(g.p0), 2))
+    pts[0::2] = g.p0
+    pts[1::2] = g.p1
+    return clean_polygon(pts, 1e-10 * float(np.abs(pts - g.q).max()))
+
+
+def clean_polygon(pts: np.ndarray, tol: float) -> shapely.Geometry:
+    """Polygon through ``pts`` without near-duplicate consecutive points.
+
+    Float noise can leave zero-width spikes where two gap rays meet one
+    vertex; dropping points closer than ``tol`` to their successor removes
+    them.  If the ring is still invalid it is repaired (polygonal parts kept).
+    """
+    step = np.abs(np.diff(pts, axis=0, append=pts[:1])).max(axis=1)
+    pts = pts[step > tol]
+    if len(pts) < 3:
+        return shapely.Polygon()
     poly = shapely.Polygon(pts)
     if not poly.is_valid:
-        poly = shapely.make_valid(poly)
-        poly = shapely.union_all(shapely.get_parts(poly)[shapely.get_type_id(shapely.get_parts(poly)) >= 3])
+        fixed = shapely.make_valid(poly)
+        parts = shapely.get_parts(fixed)
+        parts = parts[np.isin(shapely.get_type_id(parts), (3, 6))]
+        poly = shapely.union_all(parts) if len(parts) else shapely.Polygon()
     return poly
 
 

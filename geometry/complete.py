@@ -33,12 +33,12 @@ from ._common import (
     shrink_for_position,
     target_spec,
 )
-from ._vis import visibility_polygon
+from ._vis import Domain, visibility_polygon
 
 if TYPE_CHECKING:  # pragma: no cover
     from .scene import Scene
 
-__all__ = ["complete_region", "tangent_wedges"]
+__all__ = ["complete_region", "sees", "tangent_wedges"]
 
 
 def complete_region(
@@ -81,7 +81,13 @@ def complete_region(
 def _complete(scene: Scene, spec: TargetSpec) -> shapely.Geometry:
     dom = scene_domain(scene)
     vis = visibility_polygon(dom, spec.center)
-    wedges = tangent_wedges(dom.vert[dom.reflex], spec, dom.scale)
+    u = dom.vert[dom.reflex]
+    wedges, k_lo, k_hi = tangent_wedges(u, spec, dom.scale)
+    if len(wedges):
+        # A wedge side bounds the region only if the obstacle stays on one side of
+        # it at u (otherwise the tangent enters the obstacle right at u).
+        prev, nxt = dom.vert_prev[dom.reflex], dom.vert_next[dom.reflex]
+        wedges = wedges[_grazes(u, k_lo, prev, nxt) | _grazes(u, k_hi, prev, nxt)]
     if len(wedges):
         shapely.prepare(vis)
         wedges = wedges[shapely.intersects(vis, wedges)]
@@ -90,15 +96,18 @@ def _complete(scene: Scene, spec: TargetSpec) -> shapely.Geometry:
     return polygonal(shapely.difference(vis, blocked))
 
 
-def tangent_wedges(u: np.ndarray, spec: TargetSpec, scale: float) -> np.ndarray:
-    """Wedges u + cone(u - K) at points ``u`` (array of shapely Polygons).
+def tangent_wedges(u: np.ndarray, spec: TargetSpec, scale: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Wedges u + cone(u - K) at points ``u``.
 
     Each wedge is bounded by the two tangents from ``u`` to the convex set K
     (hull vertices ``spec.hull_pts``, each grown by ``spec.radius``) and is
     clipped at distance ``scale`` from its apex (beyond the scene).
+
+    Returns the wedges (array of shapely Polygons) and the two tangent points
+    on K, ``(U, 2)`` arrays, of the wedge's clockwise and counter-clockwise sides.
     """
     if len(u) == 0:
-        return np.empty(0, dtype=object)
+        return np.empty(0, dtype=object), np.empty((0, 2)), np.empty((0, 2))
     k = spec.hull_pts
     base = np.arctan2(u[:, 1] - spec.center[1], u[:, 0] - spec.center[0])
     dx = u[:, None, 0] - k[None, :, 0]
@@ -108,11 +117,17 @@ def tangent_wedges(u: np.ndarray, spec: TargetSpec, scale: float) -> np.ndarray:
     if spec.radius > 0:
         dist = np.hypot(dx, dy)
         spread = np.arcsin(np.clip(spec.radius / np.maximum(dist, 1e-300), 0.0, 1.0))
-        lo = (rel - spread).min(axis=1)
-        hi = (rel + spread).max(axis=1)
+        i_lo = np.argmin(rel - spread, axis=1)
+        i_hi = np.argmax(rel + spread, axis=1)
+        rows = np.arange(len(u))
+        lo = (rel - spread)[rows, i_lo]
+        hi = (rel + spread)[rows, i_hi]
     else:
-        lo = rel.min(axis=1)
-        hi = rel.max(axis=1)
+        i_lo = np.argmin(rel, axis=1)
+        i_hi = np.argmax(rel, axis=1)
+        rows = np.arange(len(u))
+        lo = rel[rows, i_lo]
+        hi = rel[rows, i_hi]
     half = 0.5 * (hi - lo)
     mid = base + 0.5 * (hi + lo)
     reach = 1.01 * scale
@@ -128,4 +143,45 @@ def tangent_wedges(u: np.ndarray, spec: TargetSpec, scale: float) -> np.ndarray:
         ],
         axis=1,
     )
-    return shapely.polygons(ring)
+    k_lo = _tangent_point(u, a_lo, k[i_lo], spec.radius)
+    k_hi = _tangent_point(u, a_hi, k[i_hi], spec.radius)
+    return shapely.polygons(ring), k_lo, k_hi
+
+
+def _tangent_point(u: np.ndarray, ang: np.ndarray, k: np.ndarray, radius: float) -> np.ndarray:
+    """Where the line through ``u`` at angle ``ang`` touches K: the hull vertex
+    ``k`` itself, or the foot of ``k`` on the line for discs of ``radius``."""
+    if radius <= 0:
+        return k
+    e = np.stack([np.cos(ang), np.sin(ang)], axis=1)
+    return u + ((k - u) * e).sum(axis=1)[:, None] * e
+
+
+def _grazes(u: np.ndarray, k: np.ndarray, prev: np.ndarray, nxt: np.ndarray) -> np.ndarray:
+    """True where the line through ``u`` and ``k`` has both ring neighbours of
+    ``u`` on the same (closed) side."""
+    d = k - u
+    a = d[:, 0] * (prev - u)[:, 1] - d[:, 1] * (prev - u)[:, 0]
+    b = d[:, 0] * (nxt - u)[:, 1] - d[:, 1] * (nxt - u)[:, 0]
+    return a * b >= 0
+
+
+def sees(dom: Domain, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """For point pairs ``a[i]``, ``b[i]``: True unless a domain segment properly
+    crosses the open segment between them (touching counts as seeing)."""
+    tol = 1e-12 * dom.scale * dom.scale
+    s = dom.seg
+    d = (b - a)[:, None, :]
+    p = s[None, :, :2] - a[:, None, :]
+    q = s[None, :, 2:] - a[:, None, :]
+    o1 = d[..., 0] * p[..., 1] - d[..., 1] * p[..., 0]
+    o2 = d[..., 0] * q[..., 1] - d[..., 1] * q[..., 0]
+    e = (s[:, 2:] - s[:, :2])[None, :, :]
+    r = a[:, None, :] - s[None, :, :2]
+    t = b[:, None, :] - s[None, :, :2]
+    o3 = e[..., 0] * r[..., 1] - e[..., 1] * r[..., 0]
+    o4 = e[..., 0] * t[..., 1] - e[..., 1] * t[..., 0]
+    cross = ((o1 > tol) & (o2 < -tol) | (o1 < -tol) & (o2 > tol)) & (
+        (o3 > tol) & (o4 < -tol) | (o3 < -tol) & (o4 > tol)
+    )
+    return ~cross.any(axis=1)

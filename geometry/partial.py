@@ -27,7 +27,7 @@ import numpy as np
 import shapely
 
 from ._common import check_eps, polygonal, scene_domain, shrink_for_position, target_spec
-from ._vis import TAU, Domain, Gaps, gaps_from
+from ._vis import TAU, Domain, Gaps, clean_polygon, gaps_many, local_wedge
 
 if TYPE_CHECKING:  # pragma: no cover
     from .scene import Scene
@@ -110,38 +110,68 @@ def weak_visibility(env: Domain, ring: np.ndarray, wanted: np.ndarray, eps_aim: 
     m = len(ring)
     dom = env.with_ring(ring, UNWANTED, np.where(wanted, WANTED, UNWANTED))
     fans: list[shapely.Geometry] = []
-    # anchors on the target: endpoints of wanted pieces
+    # 1. anchors on the target: endpoints of wanted pieces, seen from the front
+    #    of a wanted edge at that vertex
     edge = np.roll(ring, -1, axis=0) - ring
-    for i in range(m):
-        inc = [j for j in (i, (i - 1) % m) if wanted[j]]
-        if not inc:
-            continue
-        dirs = edge[inc]
-        extra = np.arctan2(dirs[:, 1], dirs[:, 0]) + np.pi
-        g = gaps_from(dom, ring[i], extra=np.concatenate([extra, extra - np.pi]), wedge=True)
-        mid = 0.5 * (g.lo + g.hi)
-        d = np.stack([np.cos(mid), np.sin(mid)], axis=1)
-        front = ((dirs[None, :, 0] * d[:, None, 1] - dirs[None, :, 1] * d[:, None, 0]) > 0).any(axis=1)
-        fans += _fans(g, front & (g.seg >= 0), dom, eps_aim)
-    # grazing anchors: reflex vertices of the free space around the target
-    centre = ring.mean(axis=0)
-    for v in dom.vert[dom.reflex]:
-        rel = np.arctan2(ring[:, 1] - v[1], ring[:, 0] - v[0])
-        base = np.arctan2(centre[1] - v[1], centre[0] - v[0])
-        rel = (rel - base + np.pi) % TAU - np.pi
-        near = np.abs(ring - v).max(axis=1) <= 1e-12 * dom.scale
-        rel = rel[~near]
-        lo, hi = rel.min(), rel.max()
-        if hi - lo <= 1e-12:
-            continue
-        g = gaps_from(dom, v, sector=(base + lo, hi - lo), wedge=True)
-        sees = (g.seg >= 0) & (dom.seg_tag[np.maximum(g.seg, 0)] == WANTED)
-        for run in _runs(g, sees):
-            back = gaps_from(dom, v, sector=(g.lo[run[0]] + np.pi, _width(g, run)), wedge=True)
-            fans += _fans(back, back.seg >= 0, dom, eps_aim)
+    inc = np.stack([wanted, np.roll(wanted, 1)], axis=1)  # outgoing, incoming edge wanted
+    anchors = np.flatnonzero(inc.any(axis=1))
+    if len(anchors):
+        e_out, e_in = edge[anchors], np.roll(edge, 1, axis=0)[anchors]
+        dirs = np.stack([e_out, e_in], axis=1)  # (k, 2, 2)
+        ang = np.arctan2(dirs[..., 1], dirs[..., 0])
+        extra = np.concatenate([ang + np.pi, ang], axis=1)
+        wedges = np.array([local_wedge(dom, ring[i]) for i in anchors], dtype=float)
+        for gi, i in zip(gaps_many(dom, ring[anchors], wedges=wedges, extra=extra), anchors):
+            mid = 0.5 * (gi.lo + gi.hi)
+            d = np.stack([np.cos(mid), np.sin(mid)], axis=1)
+            front = np.zeros(len(mid), dtype=bool)
+            for e, use in ((edge[i], wanted[i]), (edge[i - 1], wanted[i - 1])):
+                if use:
+                    front |= e[0] * d[:, 1] - e[1] * d[:, 0] > 0
+            fans += _fans(gi, front & (gi.seg >= 0), dom, eps_aim)
+    n_direct = len(fans)
+    # 2. grazing anchors: reflex vertices v of the free space around the target;
+    #    first the directions in which v sees a wanted piece ...
+    v = dom.vert[dom.reflex]
+    if len(v):
+        rel = np.arctan2(ring[None, :, 1] - v[:, None, 1], ring[None, :, 0] - v[:, None, 0])
+        centre = ring.mean(axis=0)
+        base = np.arctan2(centre[1] - v[:, 1], centre[0] - v[:, 0])
+        rel = (rel - base[:, None] + np.pi) % TAU - np.pi
+        on_target = (np.abs(ring[None, :, :] - v[:, None, :]).max(axis=2) <= 1e-12 * dom.scale)
+        lo = np.where(on_target, np.inf, rel).min(axis=1)
+        hi = np.where(on_target, -np.inf, rel).max(axis=1)
+        ok = hi - lo > 1e-12
+        v, sectors = v[ok], np.stack([base[ok] + lo[ok], hi[ok] - lo[ok]], axis=1)
+        vw = np.array([local_wedge(dom, x) for x in v], dtype=float).reshape(-1, 2)
+        back_q, back_sec, back_w = [], [], []
+        for k, g in enumerate(gaps_many(dom, v, sectors=sectors, wedges=vw)):
+            sees = (g.seg >= 0) & (dom.seg_tag[np.maximum(g.seg, 0)] == WANTED)
+            for run in _runs(g, sees):
+                back_q.append(v[k])
+                back_sec.append((g.lo[run[0]] + np.pi, _width(g, run)))
+                back_w.append(vw[k])
+        # ... then the placements on the opposite side of v
+        if back_q:
+            backs = gaps_many(dom, np.asarray(back_q), sectors=np.asarray(back_sec), wedges=np.asarray(back_w))
+            for g in backs:
+                fans += _fans(g, g.seg >= 0, dom, eps_aim)
     if not fans:
         return shapely.Polygon()
-    return shapely.union_all(fans)
+    return _union(fans, n_first=n_direct)
+
+
+def _union(polys: list[shapely.Geometry], n_first: int) -> shapely.Geometry:
+    """Union of polygons; the later ones are first tested (vectorised) against the
+    union of the first ``n_first`` and dropped when already covered by it."""
+    first = shapely.union_all(polys[:n_first]) if n_first else shapely.Polygon()
+    rest = np.asarray(polys[n_first:], dtype=object)
+    if len(rest) and not first.is_empty:
+        shapely.prepare(first)
+        rest = rest[~shapely.covers(first, rest)]
+    if len(rest) == 0:
+        return first
+    return shapely.union_all(np.concatenate([[first], rest]))
 
 
 def _runs(g: Gaps, mask: np.ndarray) -> list[np.ndarray]:
@@ -170,25 +200,14 @@ def _fans(g: Gaps, mask: np.ndarray, dom: Domain, eps_aim: float) -> list[shapel
     out: list[shapely.Geometry] = []
     for run in _runs(g, mask):
         r = ring_of[run]
-        for piece in np.split(run, np.flatnonzero(r[1:] != r[:-1]) + 1):
+        pieces = np.split(run, np.flatnonzero(r[1:] != r[:-1]) + 1) if eps_aim > 0 else [run]
+        for piece in pieces:
             if eps_aim > 0 and _width(g, piece) < eps_aim:
                 continue
             pts = np.empty((2 * len(piece) + 1, 2))
             pts[0] = g.q
             pts[1::2] = g.p0[piece]
             pts[2::2] = g.p1[piece]
-            out.append(_clean_polygon(pts, 1e-10 * dom.scale))
+            out.append(clean_polygon(pts, 1e-10 * dom.scale))
     return out
 
-
-def _clean_polygon(pts: np.ndarray, tol: float) -> shapely.Geometry:
-    """Polygon through ``pts`` without near-duplicate consecutive points; float
-    noise that still makes it invalid is repaired (polygonal parts kept)."""
-    step = np.abs(np.diff(pts, axis=0, append=pts[:1])).max(axis=1)
-    pts = pts[step > tol]
-    if len(pts) < 3:
-        return shapely.Polygon()
-    poly = shapely.Polygon(pts)
-    if not poly.is_valid:
-        poly = polygonal(shapely.make_valid(poly))
-    return poly
