@@ -194,13 +194,20 @@ def _width(g: Gaps, run: np.ndarray) -> float:
 
 def _fans(g: Gaps, mask: np.ndarray, dom: Domain, eps_aim: float) -> list[shapely.Geometry]:
     """Visibility polygons anchored at ``g.q``: runs of adjacent gaps in ``mask``
-    that end on the same polygon (ring), as shapely Polygons; runs whose apex
-    angle is below ``eps_aim`` are dropped."""
+    whose far side lies on one connected stretch of one polygon's boundary, as
+    shapely Polygons; with ``eps_aim > 0`` those whose apex angle is below
+    ``eps_aim`` are dropped (with ``eps_aim == 0`` runs are not split)."""
     ring_of = np.where(g.seg >= 0, dom.seg_ring[np.maximum(g.seg, 0)], -1)
     out: list[shapely.Geometry] = []
     for run in _runs(g, mask):
-        r = ring_of[run]
-        pieces = np.split(run, np.flatnonzero(r[1:] != r[:-1]) + 1) if eps_aim > 0 else [run]
+        if eps_aim > 0:
+            # split where the far side jumps to another polygon or another
+            # stretch of boundary (a depth discontinuity)
+            r = ring_of[run]
+            jump = np.abs(g.p0[run[1:]] - g.p1[run[:-1]]).max(axis=1) > 1e-9 * dom.scale
+            pieces = np.split(run, np.flatnonzero((r[1:] != r[:-1]) | jump) + 1)
+        else:
+            pieces = [run]
         for piece in pieces:
             if eps_aim > 0 and _width(g, piece) < eps_aim:
                 continue

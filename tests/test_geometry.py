@@ -1,0 +1,226 @@
+"""Hand-checked cases for the region functions (the random cross-checks against
+the CGAL oracle live in test_regions_oracle.py)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import shapely
+
+from geometry import (
+    Scene,
+    SceneError,
+    complete_region,
+    overlap_segments,
+    partial_region,
+    recognizable_region,
+)
+from geometry._vis import domain_from_geometry, visibility_polygon
+
+SQUARE = [[-1, -1], [1, -1], [1, 1], [-1, 1]]
+
+
+def scene(**kw) -> Scene:
+    d = {
+        "name": "hand",
+        "bounds": [[-10, -10], [10, -10], [10, 10], [-10, 10]],
+        "obstacles": [],
+        "target": SQUARE,
+        "goal": [[0, 0]],
+        "failure": [[6, -6]],
+    }
+    d.update(kw)
+    return Scene.from_dict(d)
+
+
+def inside(region, x, y) -> bool:
+    return bool(region.contains(shapely.Point(x, y)))
+
+
+def test_empty_room_everything_sees_the_target():
+    sc = scene()
+    r = complete_region(sc, target_at=(0, 0, 0))
+    expected = sc.free_space.difference(sc.target_at(0, 0, 0))
+    assert r.symmetric_difference(expected).area < 1e-9
+
+
+def test_block_casts_tangent_bounded_shadow():
+    # Block [-1,1]x[3,5] above the target [-1,1]^2: the inner tangents are the
+    # lines through (1,3)-(-1,1) (y = x + 2) and (-1,3)-(1,1) (y = -x + 2).
+    sc = scene(obstacles=[[[-1, 3], [1, 3], [1, 5], [-1, 5]]])
+    r = complete_region(sc, target_at=(0, 0, 0))
+    assert not inside(r, 0, 8)  # straight behind
+    assert not inside(r, 5, 7.2)  # just above y = x + 2: the corner (-1,1) is hidden
+    assert inside(r, 5, 6.8)  # just below: everything visible
+    assert not inside(r, -5, 7.2)
+    assert inside(r, -5, 6.8)
+    # exact area of the shadow inside the room: the region y > x + 2, y > -x + 2, y > 3
+    # minus the block, clipped to the room
+    shadow = shapely.Polygon([(-8, 10), (-1, 3), (1, 3), (8, 10)]).difference(
+        shapely.box(-1, 3, 1, 5)
+    )
+    assert abs(r.area - (sc.free_space.area - 4.0 - shadow.area)) < 1e-9
+
+
+def test_shadow_is_not_the_union_of_corner_shadows():
+    # (0, 9.5) sees all four target corners past the small block, yet the block
+    # hides the middle of the target's top edge (paper 3.1.1)
+    sc = scene(obstacles=[[[-0.2, 3], [0.2, 3], [0.2, 3.4], [-0.2, 3.4]]])
+    r = complete_region(sc, target_at=(0, 0, 0))
+    corners = sc.target_at(0, 0, 0).exterior.coords[:-1]
+    block = shapely.box(-0.2, 3, 0.2, 3.4)
+    assert not any(shapely.LineString([(0, 9.5), c]).intersects(block) for c in corners)
+    assert not inside(r, 0, 9.5)
+    assert inside(partial_region(sc, target_at=(0, 0, 0)), 0, 9.5)
+
+
+def test_translating_region_is_inside_stationary_regions():
+    sc = scene(
+        obstacles=[[[-1, 3], [1, 3], [1, 5], [-1, 5]], [[4, -2], [5, -2], [5, 2]]],
+        goal=[[-0.5, -0.5], [0.5, -0.5], [0.0, 0.4]],
+    )
+    moving = complete_region(sc, target_in="goal", theta=0.0)
+    for q in [(-0.5, -0.5), (0.5, -0.5), (0.0, 0.4), (0.0, 0.0)]:
+        fixed = complete_region(sc, target_at=(*q, 0.0))
+        assert moving.difference(fixed).area < 1e-9
+
+
+def test_rotating_target_uses_disc_tangents():
+    # G is the point (0,0); with any orientation the target sweeps the disc of
+    # radius sqrt(2).  The tangents from the block corner (1,3) to that disc.
+    rect = [[-1, -0.5], [1, -0.5], [1, 0.5], [-1, 0.5]]
+    sc = scene(target=rect, obstacles=[[[-1, 3], [1, 3], [1, 5], [-1, 5]]])
+    r = complete_region(sc, target_in="goal", theta=None)
+    rad = math.hypot(1, 0.5)
+    d = math.hypot(1, 3)
+    # the inner tangent from the block corner (1,3) to the disc, continued up-right:
+    # placements below it see the whole disc, those above do not
+    ang = math.atan2(3, 1) - math.asin(rad / d)
+    direction = np.array([math.cos(ang), math.sin(ang)])
+    normal = np.array([-direction[1], direction[0]])
+    p = np.array([1, 3]) + 5 * direction
+    assert inside(r, *(p - 1e-3 * normal))
+    assert not inside(r, *(p + 1e-3 * normal))
+    assert not inside(r, *(p + 1e-3 * normal)) or True
+    fixed = complete_region(sc, target_at=(0, 0, 0.7))
+    assert r.difference(fixed).area < 1e-9
+
+
+def test_partial_sees_through_a_gap():
+    # a wall with a narrow gap between the target and the top of the room
+    wall = [[[-10, 3], [-0.2, 3], [-0.2, 3.5], [-10, 3.5]], [[0.2, 3], [10, 3], [10, 3.5], [0.2, 3.5]]]
+    sc = scene(obstacles=wall)
+    part = partial_region(sc, target_at=(0, 0, 0))
+    full = complete_region(sc, target_at=(0, 0, 0))
+    assert inside(part, 0, 8)  # through the gap
+    assert not inside(full, 0, 8)  # but not the whole target
+    assert not inside(part, 6, 8)  # behind the wall
+    # the lines through the gap's corners and the target's far corners bound the region
+    # at y = 8: from (1,1) through (-0.2,3.5) lies at x = 1 + (-1.2)/2.5*7
+    edge = 1 + (-1.2) / 2.5 * 7
+    assert inside(part, edge + 1e-3, 8) and not inside(part, edge - 1e-3, 8)
+    assert full.difference(part).area < 1e-9
+
+
+def test_eps_aim_drops_narrow_fans():
+    wall = [[[-10, 3], [-0.05, 3], [-0.05, 3.5], [-10, 3.5]], [[0.05, 3], [10, 3], [10, 3.5], [0.05, 3.5]]]
+    sc = scene(obstacles=wall)
+    wide = partial_region(sc, target_at=(0, 0, 0))
+    narrow = partial_region(sc, target_at=(0, 0, 0), eps_aim=0.2)
+    # from (0, 8) the target is seen only through the 0.1-wide, 0.5-deep slit: the
+    # fans anchored at the slit's corners open atan(0.1 / 0.5) = 0.197 rad
+    assert inside(wide, 0, 8) and not inside(narrow, 0, 8)
+    assert inside(partial_region(sc, target_at=(0, 0, 0), eps_aim=0.19), 0, 8)
+    assert narrow.difference(wide).area < 1e-9
+
+
+def test_eps_pos_keeps_a_margin_from_shadows():
+    sc = scene(obstacles=[[[-1, 3], [1, 3], [1, 5], [-1, 5]]])
+    r0 = complete_region(sc, target_at=(0, 0, 0))
+    r1 = complete_region(sc, target_at=(0, 0, 0), eps_pos=0.3)
+    assert r1.difference(r0).area < 1e-9
+    assert inside(r0, 5, 6.8) and not inside(r1, 5, 6.8)  # 0.14 from the tangent
+    assert inside(r1, 5, 6.0)  # 0.7 away
+
+
+def test_overlap_segments_and_partial_recognition():
+    rect = [[-1, -0.5], [1, -0.5], [1, 0.5], [-1, 0.5]]
+    sc = scene(target=rect, goal=[[0, 0]], failure=[[1.2, 0]])
+    segs = sorted(tuple(sorted(np.round(s.coords, 12).tolist())) for s in overlap_segments(sc))
+    segs = [tuple(map(tuple, s)) for s in segs]
+    assert segs == [((0.2, -0.5), (1.0, -0.5)), ((0.2, 0.5), (1.0, 0.5))]
+    r = recognizable_region(sc, model="partial")
+    # in an open room every placement outside both targets sees a non-overlap part
+    both = sc.target_at(0, 0, 0).union(sc.target_at(1.2, 0, 0))
+    assert r.symmetric_difference(sc.free_space.difference(both)).area < 1e-9
+    # through a slit above the overlap only overlapping top edges are seen
+    slit = [[[-10, 2], [0.5, 2], [0.5, 2.5], [-10, 2.5]], [[0.7, 2], [10, 2], [10, 2.5], [0.7, 2.5]]]
+    sc2 = scene(target=rect, goal=[[0, 0]], failure=[[1.2, 0]], obstacles=slit)
+    r2 = recognizable_region(sc2, model="partial")
+    assert inside(partial_region(sc2, target_at=(0, 0, 0)), 0.6, 8)
+    assert inside(partial_region(sc2, target_at=(1.2, 0, 0)), 0.6, 8)
+    assert not inside(r2, 0.6, 8)
+    assert inside(r2, -5, 0)
+    rc = recognizable_region(sc2, model="complete")
+    assert rc.difference(r2).area < 1e-9
+
+
+def test_separated_rooms_give_an_empty_answer():
+    wall = [[[-10, -0.5], [10, -0.5], [10, 0.5], [-10, 0.5]]]
+    sc = scene(obstacles=wall, target=[[-0.3, -0.3], [0.3, -0.3], [0.3, 0.3], [-0.3, 0.3]], goal=[[0, 3]], failure=[[0, -3]])
+    for model in ("complete", "partial"):
+        r = recognizable_region(sc, model=model)
+        assert r.is_empty and r.geom_type in ("Polygon", "MultiPolygon")
+
+
+def test_symmetric_target_of_unknown_orientation_is_confusable():
+    # square with its reference point off-centre: turning it by 90 degrees about its
+    # centre moves the reference point by 2 |s| sin(45 deg) = 0.8
+    tgt = [[-0.1, -0.1], [0.9, -0.1], [0.9, 0.9], [-0.1, 0.9]]
+    sc = scene(target=tgt, goal=[[-3, -3]], failure=[[-2.2, -3]])
+    assert recognizable_region(sc, model="complete", theta=None).is_empty
+    far = scene(target=tgt, goal=[[-3, -3]], failure=[[3, -3]])
+    assert not recognizable_region(far, model="complete", theta=None).is_empty
+
+
+def test_bad_arguments_fail_clearly():
+    sc = scene(goal=[[-2, -2], [-1, -2], [-1.5, -1]])
+    with pytest.raises(ValueError, match="exactly one"):
+        complete_region(sc)
+    with pytest.raises(ValueError, match="exactly one"):
+        complete_region(sc, target_at=(0, 0, 0), target_in="goal")
+    with pytest.raises(ValueError, match="eps_pos"):
+        complete_region(sc, target_at=(0, 0, 0), eps_pos=-1)
+    with pytest.raises(ValueError, match="eps_aim"):
+        partial_region(sc, target_at=(0, 0, 0), eps_aim=float("nan"))
+    with pytest.raises(ValueError, match="target_in"):
+        complete_region(sc, target_in="home")
+    with pytest.raises(ValueError, match="model"):
+        recognizable_region(sc, model="weak")
+    with pytest.raises(NotImplementedError, match="3.2.2"):
+        partial_region(sc, target_in="goal")
+    with pytest.raises(NotImplementedError, match="3.2.2"):
+        recognizable_region(sc, model="partial")
+    with pytest.raises(NotImplementedError, match="orientation"):
+        recognizable_region(scene(), model="partial", theta=None)
+
+
+def test_obstacle_in_hull_for_a_query_is_a_scene_error():
+    sc = scene(obstacles=[[[1.6, -0.2], [2.5, -0.2], [2.5, 0.2], [1.6, 0.2]]],
+               target=[[-0.5, -0.2], [1.5, -0.2], [1.5, 0.2], [-0.5, 0.2]])
+    complete_region(sc, target_at=(0, 0, 0))
+    with pytest.raises(SceneError, match="assumption"):
+        complete_region(sc, target_at=(0.5, 0, 0))
+
+
+def test_visibility_polygon_of_a_point_in_a_room_with_a_pillar():
+    free = shapely.box(0, 0, 4, 4).difference(shapely.box(1.5, 1.5, 2.5, 2.5))
+    dom = domain_from_geometry(free)
+    v = visibility_polygon(dom, np.array([0.5, 2.0]))
+    # the pillar hides the part of the room behind it: a trapezoid from the
+    # pillar's back face to the far wall, between the rays through (1.5, 1.5)
+    # and (1.5, 2.5) -> at x = 4 they are at y = 2 -/+ 3.5 * 0.5 / 1.0
+    hidden = shapely.Polygon([(1.5, 1.5), (4, 0.25), (4, 3.75), (1.5, 2.5)]).difference(shapely.box(1.5, 1.5, 2.5, 2.5))
+    assert abs(v.area - (free.area - hidden.area)) < 1e-9
