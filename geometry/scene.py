@@ -272,9 +272,7 @@ class SensorSpec:
             raise SceneError(f"sensor: expected an object, got {_short(d)}")
         for k in d:
             if k not in SENSOR_KEYS:
-                raise SceneError(
-                    f"sensor: unknown key {k!r} (allowed: {', '.join(SENSOR_KEYS)})"
-                )
+                raise SceneError(f"sensor: unknown key {k!r} (allowed: {', '.join(SENSOR_KEYS)})")
         return cls(**dict(d))
 
     def to_dict(self) -> dict[str, Any]:

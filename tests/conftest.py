@@ -10,9 +10,7 @@ import pytest
 from hypothesis import HealthCheck, settings
 
 # Geometry is deterministic but timing on the 2-core CI machine is not: no deadlines.
-settings.register_profile(
-    "dev", deadline=None, suppress_health_check=[HealthCheck.too_slow]
-)
+settings.register_profile("dev", deadline=None, suppress_health_check=[HealthCheck.too_slow])
 settings.register_profile(
     "ci", deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow]
 )

@@ -399,7 +399,9 @@ def test_region_outside_free_space(lab_dict, which):
     other = "failure" if which == "goal" else "goal"
     lab_dict[other] = [[1, 9]]
     inside_obstacle = [[6.5, 6.5], [7.5, 6.5], [7.5, 7.5]]
-    pattern = rf"{which}: not inside the free space \(bounds minus obstacles\): meets obstacles\[0\]"
+    pattern = (
+        rf"{which}: not inside the free space \(bounds minus obstacles\): meets obstacles\[0\]"
+    )
     with pytest.raises(SceneError, match=pattern):
         build(lab_dict, **{which: inside_obstacle})
     with pytest.raises(SceneError, match=rf"{which}: not inside the free space"):
@@ -418,7 +420,8 @@ def test_region_outside_free_space(lab_dict, which):
     ],
 )
 def test_goal_failure_overlap(lab_dict, goal, failure):
-    with pytest.raises(SceneError, match=r"goal and failure overlap at .*recognition is impossible"):
+    pattern = r"goal and failure overlap at .*recognition is impossible"
+    with pytest.raises(SceneError, match=pattern):
         build(lab_dict, goal=goal, failure=failure)
     with pytest.raises(SceneError, match=r"goal and failure overlap"):
         build(lab_dict, goal=failure, failure=goal)
