@@ -1,0 +1,18 @@
+"""Gymnasium environments for robust sensor planning (Briggs & Donald).
+
+Importing the package registers ``sensorplan/Placement-v0``, ``sensorplan/Navigate-v0`` and
+``sensorplan/Recognize-v0``; ``gym.make("sensorplan_gym:sensorplan/Navigate-v0")`` works
+without a prior import.  Rewards are exact: they come from
+:func:`geometry.recognizable_region`.
+
+>>> import gymnasium as gym
+>>> env = gym.make("sensorplan_gym:sensorplan/Navigate-v0", scene="lab")
+>>> obs, info = env.reset(seed=0)
+"""
+
+from .core.world import BUNDLED_SCENES
+from .registration import ENV_IDS, register_sensorplan_envs
+
+register_sensorplan_envs()
+
+__all__ = ["BUNDLED_SCENES", "ENV_IDS", "register_sensorplan_envs"]

@@ -1,0 +1,1 @@
+"""Scene-derived data (world), the range sensor, observation builders and rendering."""

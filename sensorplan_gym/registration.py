@@ -1,0 +1,22 @@
+"""Registration of the Gymnasium ids (entry points are strings: nothing heavy is imported
+until ``gym.make``)."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+
+__all__ = ["ENV_IDS", "register_sensorplan_envs"]
+
+ENV_IDS = {
+    "sensorplan/Placement-v0": ("sensorplan_gym.envs.placement:PlacementEnv", 1),
+    "sensorplan/Navigate-v0": ("sensorplan_gym.envs.navigate:NavigateEnv", 200),
+    "sensorplan/Recognize-v0": ("sensorplan_gym.envs.recognize:RecognizeEnv", 200),
+}
+
+
+def register_sensorplan_envs() -> None:
+    """Register every sensorplan id once (idempotent)."""
+    for env_id, (entry_point, steps) in ENV_IDS.items():
+        if env_id in gym.registry:
+            continue
+        gym.register(id=env_id, entry_point=entry_point, max_episode_steps=steps)
