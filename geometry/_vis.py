@@ -53,6 +53,15 @@ class Domain:
     reflex: np.ndarray
     scale: float
 
+    @property
+    def vert_wedge(self) -> np.ndarray:
+        """(V, 2) free wedge ``(start, width)`` at every vertex: counter-clockwise
+        from the direction of the next vertex to that of the previous one."""
+        a = np.arctan2(self.vert_next[:, 1] - self.vert[:, 1], self.vert_next[:, 0] - self.vert[:, 0])
+        b = np.arctan2(self.vert_prev[:, 1] - self.vert[:, 1], self.vert_prev[:, 0] - self.vert[:, 0])
+        w = (b - a) % TAU
+        return np.stack([a, np.where(w == 0.0, TAU, w)], axis=1)
+
     @staticmethod
     def from_rings(rings: list[np.ndarray], tags: list[int]) -> Domain:
         """Build a domain from closed rings (without repeated closing vertex).
@@ -144,6 +153,10 @@ class Gaps:
     ``hi[i]`` (equal to ``q`` for blocked gaps).
     """
 
+    def part(self, a: int, b: int) -> Gaps:
+        """Gaps ``a:b`` of a flat result of one viewpoint (see :func:`gaps_many`)."""
+        return Gaps(q=self.q[a], lo=self.lo[a:b], hi=self.hi[a:b], seg=self.seg[a:b], p0=self.p0[a:b], p1=self.p1[a:b])
+
     q: np.ndarray
     lo: np.ndarray
     hi: np.ndarray
@@ -224,12 +237,17 @@ def gaps_many(
     sectors: np.ndarray | None = None,
     wedges: np.ndarray | None = None,
     extra: np.ndarray | None = None,
-) -> list[Gaps]:
+    flat: bool = False,
+) -> list[Gaps] | tuple[Gaps, np.ndarray]:
     """:func:`gaps_from` for many viewpoints at once (one vectorised ray cast).
 
     ``q`` is (n, 2); ``sectors`` and ``wedges`` are (n, 2) arrays of
     ``(start, width)`` (a NaN row means no restriction); ``extra`` is (n, k)
     extra critical directions (NaN entries ignored).
+
+    Returns one :class:`Gaps` per viewpoint, or with ``flat=True`` all gaps in
+    one :class:`Gaps` (``q`` then holds one row per gap) plus the (n+1,) offsets
+    of each viewpoint's gaps.
     """
     n = len(q)
     tol = 1e-12 * dom.scale
@@ -274,6 +292,8 @@ def gaps_many(
         sg = dom.seg[seg[ok]]
         p0[ok] = _ray_line(qo[ok], lo[ok], sg)
         p1[ok] = _ray_line(qo[ok], hi[ok], sg)
+    if flat:
+        return Gaps(q=qo, lo=lo, hi=hi, seg=seg, p0=p0, p1=p1), np.searchsorted(owner, np.arange(n + 1))
     cuts = np.searchsorted(owner, np.arange(1, n))
     return [
         Gaps(q=q[i], lo=l_, hi=h_, seg=s_, p0=a_, p1=b_)

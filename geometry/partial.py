@@ -27,7 +27,7 @@ import numpy as np
 import shapely
 
 from ._common import check_eps, polygonal, scene_domain, shrink_for_position, target_spec
-from ._vis import TAU, Domain, Gaps, clean_polygon, gaps_many, local_wedge
+from ._vis import TAU, Domain, Gaps, clean_polygon, gaps_many
 
 if TYPE_CHECKING:  # pragma: no cover
     from .scene import Scene
@@ -120,7 +120,7 @@ def weak_visibility(env: Domain, ring: np.ndarray, wanted: np.ndarray, eps_aim: 
         dirs = np.stack([e_out, e_in], axis=1)  # (k, 2, 2)
         ang = np.arctan2(dirs[..., 1], dirs[..., 0])
         extra = np.concatenate([ang + np.pi, ang], axis=1)
-        wedges = np.array([local_wedge(dom, ring[i]) for i in anchors], dtype=float)
+        wedges = dom.vert_wedge[len(env.vert) + anchors]
         for gi, i in zip(gaps_many(dom, ring[anchors], wedges=wedges, extra=extra), anchors):
             mid = 0.5 * (gi.lo + gi.hi)
             d = np.stack([np.cos(mid), np.sin(mid)], axis=1)
@@ -142,20 +142,22 @@ def weak_visibility(env: Domain, ring: np.ndarray, wanted: np.ndarray, eps_aim: 
         lo = np.where(on_target, np.inf, rel).min(axis=1)
         hi = np.where(on_target, -np.inf, rel).max(axis=1)
         ok = hi - lo > 1e-12
+        vw = dom.vert_wedge[dom.reflex][ok]
         v, sectors = v[ok], np.stack([base[ok] + lo[ok], hi[ok] - lo[ok]], axis=1)
-        vw = np.array([local_wedge(dom, x) for x in v], dtype=float).reshape(-1, 2)
+        g, off = gaps_many(dom, v, sectors=sectors, wedges=vw, flat=True)
+        sees = (g.seg >= 0) & (dom.seg_tag[np.maximum(g.seg, 0)] == WANTED)
         back_q, back_sec, back_w = [], [], []
-        for k, g in enumerate(gaps_many(dom, v, sectors=sectors, wedges=vw)):
-            sees = (g.seg >= 0) & (dom.seg_tag[np.maximum(g.seg, 0)] == WANTED)
-            for run in _runs(g, sees):
+        for k in np.unique(np.searchsorted(off, np.flatnonzero(sees), side="right") - 1):
+            gk = g.part(off[k], off[k + 1])
+            for run in _runs(gk, sees[off[k] : off[k + 1]]):
                 back_q.append(v[k])
-                back_sec.append((g.lo[run[0]] + np.pi, _width(g, run)))
+                back_sec.append((gk.lo[run[0]] + np.pi, _width(gk, run)))
                 back_w.append(vw[k])
         # ... then the placements on the opposite side of v
         if back_q:
             backs = gaps_many(dom, np.asarray(back_q), sectors=np.asarray(back_sec), wedges=np.asarray(back_w))
-            for g in backs:
-                fans += _fans(g, g.seg >= 0, dom, eps_aim)
+            for gb in backs:
+                fans += _fans(gb, gb.seg >= 0, dom, eps_aim)
     if not fans:
         return shapely.Polygon()
     return _union(fans, n_first=n_direct)
