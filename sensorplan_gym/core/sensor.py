@@ -109,7 +109,7 @@ def cast_rays(
         u = DM[:, S_n:] * inv
     w = np.minimum(u, 1.0 - u)
     np.minimum(w, t, out=w)
-    t[w < 0.0] = np.inf
+    t[~(w >= 0.0)] = np.inf  # also NaN (collinear ray and segment)
     idx = t.argmin(axis=1)
     dist = t[_rows(n), idx]
     hit = dist <= max_range

@@ -45,7 +45,9 @@ from shapely.geometry import Point
 
 from geometry import Scene, SceneError, recognizable_region
 
-from .sensor import Segments
+from .sensor import Segments, cast_rays
+
+_UNIT = np.array([[1.0, 0.0]])
 
 __all__ = [
     "BUNDLED_SCENES",
@@ -164,6 +166,13 @@ def sweep(p, d, S: Segments, radius: float, skin: float) -> float:
     dx, dy = float(d[0]), float(d[1])
     if not S.n or (dx == 0.0 and dy == 0.0):
         return 1.0
+    if radius == 0.0:  # a point: one ray of length |d|
+        L = math.hypot(dx, dy)
+        dist, nrm, hit = cast_rays(p[0], p[1], math.atan2(dy, dx), _UNIT, S, L)
+        if not hit[0]:
+            return 1.0
+        rate = abs(float(nrm[0, 0]) * dx + float(nrm[0, 1]) * dy)  # approach speed
+        return max(0.0, float(dist[0]) / L - skin / max(rate, 1e-300))
     ax = p[0] - S.x0
     ay = p[1] - S.y0
     L = np.sqrt(S.L2)
@@ -311,9 +320,8 @@ class World:
             g = self.goal_geom if which == "goal" else self.failure_geom
             tris = shapely.constrained_delaunay_triangles(g)
             arr = np.array([np.asarray(t.exterior.coords)[:3] for t in tris.geoms])
-            areas = np.abs(
-                np.cross(arr[:, 1] - arr[:, 0], arr[:, 2] - arr[:, 0])
-            ) / 2.0
+            u, v = arr[:, 1] - arr[:, 0], arr[:, 2] - arr[:, 0]
+            areas = np.abs(u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]) / 2.0
             self._cache[key] = (arr, np.cumsum(areas) / areas.sum())
         return self._cache[key]
 

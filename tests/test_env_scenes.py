@@ -1,0 +1,62 @@
+"""Bundled scenes: valid, with a non-empty recognizable region (complete model, translating
+target, theta = 0) reachable from the start, and the start outside it."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import pytest
+import shapely
+
+import sensorplan_gym
+from geometry import Scene, recognizable_region
+from sensorplan_gym.core.world import bundled_scene_path, load_scene
+
+SCENES = sensorplan_gym.BUNDLED_SCENES
+
+
+def test_bundled_scene_set():
+    assert {"lab", "edr"} <= set(SCENES) and len(SCENES) >= 4
+
+
+@pytest.mark.parametrize("name", SCENES)
+def test_region_nonempty_reachable_start_outside(name):
+    scene = Scene.load(bundled_scene_path(name))
+    assert scene.start is not None
+    R = recognizable_region(scene, model="complete", theta=0.0)
+    assert R.area > 0.1
+    start = shapely.Point(scene.start[:2])
+    assert not R.covers(start)
+    comps = getattr(scene.free_space, "geoms", [scene.free_space])
+    comp = next(c for c in comps if c.covers(start))
+    assert comp.intersection(R).area > 0.1
+
+
+@pytest.mark.parametrize("name", SCENES)
+def test_scene_roundtrip_and_envs_build(name):
+    scene = load_scene(name)
+    assert Scene.from_dict(scene.to_dict()).to_dict() == scene.to_dict()
+    for env_id in sensorplan_gym.ENV_IDS:
+        env = gym.make(env_id, scene=name)
+        env.reset(seed=0)
+        env.step(env.action_space.sample())
+
+
+def test_lab_start_sees_neither_like_tommy():
+    """From TOMMY's start neither the doorway G nor the nook H is completely visible."""
+    from geometry import complete_region
+
+    scene = load_scene("lab")
+    p = shapely.Point(scene.start[:2])
+    assert not complete_region(scene, target_in="failure").covers(p)
+    env = gym.make("sensorplan/Navigate-v0", scene="lab").unwrapped
+    _, info = env.reset(seed=0)
+    assert not info["recognizing"]
+
+
+def test_scene_from_path(tmp_path):
+    p = tmp_path / "mine.json"
+    load_scene("edr").save(p)
+    env = gym.make("sensorplan/Placement-v0", scene=str(p))
+    env.reset(seed=0)
+    with pytest.raises(FileNotFoundError):
+        gym.make("sensorplan/Placement-v0", scene=str(tmp_path / "missing.json"))
