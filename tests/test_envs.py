@@ -416,3 +416,14 @@ def test_placement_reward_positive_at_best_aim():
     shaped.reset(seed=0)
     _, r, *_ = shaped.step(np.array([-1.0, -1.0, 0.0]))
     assert r < 0
+
+
+def test_render_rollout_png(tmp_path):
+    from sensorplan_gym.render_rollout import main
+
+    out = tmp_path / "rollout.png"
+    main(["--env", "sensorplan/Recognize-v0", "--out", str(out), "--steps", "3", "--frames", "2"])
+    import matplotlib.image
+
+    img = matplotlib.image.imread(out)
+    assert img.ndim == 3 and img.shape[0] > 100 and img.shape[1] > 200

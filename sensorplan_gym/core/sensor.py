@@ -45,20 +45,19 @@ class Segments:
         self.N = np.ascontiguousarray(normals, dtype=np.float64).reshape(-1, 2)
         self.nx = self.N[:, 0].copy()
         self.ny = self.N[:, 1].copy()
-        x0, y0, ex, ey = self.x0, self.y0, self.ex, self.ey
+        x0, y0, ex, ey, n = self.x0, self.y0, self.ex, self.ey, self.n
         # [dx, dy, dx*oy - dy*ox] @ M = [cross(d, e) | cross(a - o, d)]
-        z = np.zeros(self.n)
-        self.M = np.ascontiguousarray(
-            np.block([[ey[None], -y0[None]], [-ex[None], x0[None]], [z[None], np.ones((1, self.n))]])
-        )
+        M = np.zeros((3, 2 * n))
+        M[0, :n], M[0, n:] = ey, -y0
+        M[1, :n], M[1, n:] = -ex, x0
+        M[2, n:] = 1.0
+        self.M = M
         # [1, ox, oy] @ Q = [cross(a - o, e) | n . (o - a)]
-        self.Q = np.ascontiguousarray(
-            np.block([
-                [(x0 * ey - y0 * ex)[None], -(self.nx * x0 + self.ny * y0)[None]],
-                [-ey[None], self.nx[None]],
-                [ex[None], self.ny[None]],
-            ])
-        )
+        Q = np.empty((3, 2 * n))
+        Q[0, :n], Q[0, n:] = x0 * ey - y0 * ex, -(self.nx * x0 + self.ny * y0)
+        Q[1, :n], Q[1, n:] = -ey, self.nx
+        Q[2, :n], Q[2, n:] = ex, self.ny
+        self.Q = Q
 
     def __getstate__(self):
         return {"segs": self.segs, "normals": self.N}

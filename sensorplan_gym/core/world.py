@@ -488,7 +488,7 @@ class _FastDistance:
     def __init__(self, segs: np.ndarray) -> None:
         self.segs = segs
         self.small = segs.shape[0] <= 24
-        self.S = Segments(segs)
+        self.S = None if self.small else Segments(segs)
         if self.small:
             self.rows = [
                 (float(x0), float(y0), float(x1 - x0), float(y1 - y0),

@@ -1,0 +1,85 @@
+"""Render a short random-agent rollout to a PNG contact sheet.
+
+    python -m sensorplan_gym.render_rollout --env sensorplan/Navigate-v0 --out rollout.png
+
+Runs one episode (or ``--steps`` steps, whichever ends first) with random actions, keeps
+``--frames`` evenly spaced frames (the first and the last included) and writes them side
+by side in rows of ``--cols``.  Extra ``--kw key=value`` pairs go to ``gym.make`` (values
+are parsed as JSON when possible, e.g. ``--kw fov_deg=120 --kw scene='"edr"'``).
+For Recognize-v0 the random agent only declares in the last step.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+import gymnasium as gym
+import numpy as np
+
+import sensorplan_gym  # noqa: F401
+
+
+def _kw(pairs):
+    out = {}
+    for p in pairs or []:
+        k, _, v = p.partition("=")
+        try:
+            out[k] = json.loads(v)
+        except json.JSONDecodeError:
+            out[k] = v
+    return out
+
+
+def rollout_frames(env_id: str, *, steps: int = 60, seed: int = 0, **kwargs) -> list[np.ndarray]:
+    env = gym.make(env_id, render_mode="rgb_array", **kwargs)
+    env.reset(seed=seed)
+    env.action_space.seed(seed)
+    frames = [env.render()]
+    for i in range(steps):
+        a = env.action_space.sample()
+        if a.shape == (4,):  # Recognize: keep looking, declare at the end
+            a[3] = 0.0 if i < steps - 1 else (-1.0 if i % 2 else 1.0)
+        _, _, te, tr, _ = env.step(a)
+        frames.append(env.render())
+        if te or tr:
+            break
+    env.close()
+    return frames
+
+
+def contact_sheet(frames: list[np.ndarray], n: int, cols: int) -> np.ndarray:
+    idx = np.unique(np.linspace(0, len(frames) - 1, min(n, len(frames))).round().astype(int))
+    pick = [frames[i] for i in idx]
+    h, w, _ = pick[0].shape
+    rows = -(-len(pick) // cols)
+    sheet = np.full((rows * h + (rows - 1) * 4, min(cols, len(pick)) * w + (min(cols, len(pick)) - 1) * 4, 3),
+                    255, np.uint8)
+    for k, f in enumerate(pick):
+        r, c = divmod(k, cols)
+        sheet[r * (h + 4): r * (h + 4) + h, c * (w + 4): c * (w + 4) + w] = f
+    return sheet
+
+
+def main(argv=None) -> None:
+    ap = argparse.ArgumentParser(description="Render a random-agent rollout to a PNG.")
+    ap.add_argument("--env", default="sensorplan/Navigate-v0")
+    ap.add_argument("--scene", default="lab")
+    ap.add_argument("--out", default="rollout.png")
+    ap.add_argument("--steps", type=int, default=60)
+    ap.add_argument("--frames", type=int, default=6)
+    ap.add_argument("--cols", type=int, default=3)
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--kw", action="append", help="extra gym.make kwarg key=value")
+    args = ap.parse_args(argv)
+    kwargs = {"scene": args.scene, **_kw(args.kw)}
+    frames = rollout_frames(args.env, steps=args.steps, seed=args.seed, **kwargs)
+    sheet = contact_sheet(frames, args.frames, args.cols)
+    import matplotlib.image
+
+    matplotlib.image.imsave(args.out, sheet)
+    print(f"wrote {args.out} ({len(frames)} frames rendered, {sheet.shape[1]}x{sheet.shape[0]} px)")
+
+
+if __name__ == "__main__":
+    main()
