@@ -278,27 +278,9 @@ def _visible(cover: BaseGeometry, p: np.ndarray, q: np.ndarray) -> np.ndarray:
 
 def _dijkstra(n: int, i: np.ndarray, j: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Single-source (node 0) shortest distances and predecessors on an undirected graph."""
-    try:
-        from scipy.sparse import coo_matrix
-        from scipy.sparse.csgraph import dijkstra
-    except ImportError:  # pragma: no cover - scipy is optional; dense O(n^2) fallback
-        W = np.full((n, n), np.inf)
-        W[i, j] = np.minimum(W[i, j], w)
-        W[j, i] = np.minimum(W[j, i], w)
-        dist = np.full(n, np.inf)
-        pred = np.full(n, -9999)
-        done = np.zeros(n, dtype=bool)
-        dist[0] = 0.0
-        for _ in range(n):
-            u = int(np.argmin(np.where(done, np.inf, dist)))
-            if done[u] or not np.isfinite(dist[u]):
-                break
-            done[u] = True
-            alt = dist[u] + W[u]
-            better = (alt < dist) & ~done
-            dist[better] = alt[better]
-            pred[better] = u
-        return dist, pred
+    from scipy.sparse import coo_matrix  # imported lazily: scipy loads in ~0.5 s
+    from scipy.sparse.csgraph import dijkstra
+
     # zero-length edges would vanish from a sparse matrix: give them a tiny positive weight
     w = np.maximum(w, 1e-300)
     g = coo_matrix((w, (i, j)), shape=(n, n)).tocsr()
