@@ -1,0 +1,1 @@
+"""Benchmarks of sensorplan-gym (run as modules, e.g. ``python -m benchmarks.regions``)."""
