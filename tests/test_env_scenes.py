@@ -60,3 +60,28 @@ def test_scene_from_path(tmp_path):
     env.reset(seed=0)
     with pytest.raises(FileNotFoundError):
         gym.make("sensorplan/Placement-v0", scene=str(tmp_path / "missing.json"))
+
+
+@pytest.mark.parametrize("name", SCENES)
+def test_some_pose_recognizes_with_scene_fov(name):
+    """With the scene's own field of view, some reachable placement has a valid aim."""
+    import numpy as np
+
+    env = gym.make("sensorplan/Navigate-v0", scene=name).unwrapped
+    env.reset(seed=0)
+    w = env.world
+    R = w.reachable_region(env.start[:2])
+    rng = np.random.default_rng(0)
+    minx, miny, maxx, maxy = R.bounds
+    found = False
+    for _ in range(4000):
+        x, y = rng.uniform(minx, maxx), rng.uniform(miny, maxy)
+        if not w.in_region(x, y):
+            continue
+        for psi in w.best_aim(x, y) + np.linspace(-1.5, 1.5, 13):
+            if w.recognizing(x, y, psi):
+                found = True
+                break
+        if found:
+            break
+    assert found

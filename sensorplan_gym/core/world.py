@@ -41,6 +41,7 @@ from typing import Any
 
 import numpy as np
 import shapely
+import shapely.geometry.polygon
 from shapely.geometry import Point
 
 from geometry import Scene, SceneError, recognizable_region
@@ -295,8 +296,8 @@ class World:
         else:
             tpts = self.target
         pts = (gpts[:, None, :] + tpts[None, :, :]).reshape(-1, 2)
-        hull = shapely.MultiPoint(pts).convex_hull
-        c = np.asarray(hull.exterior.coords)[:-1]
+        hull = shapely.geometry.polygon.orient(shapely.MultiPoint(pts).convex_hull, 1.0)
+        c = np.asarray(hull.exterior.coords)[:-1]  # counter-clockwise
         return c
 
     def reachable_region(self, start_xy: tuple[float, float]) -> shapely.Geometry:
@@ -482,19 +483,20 @@ except ImportError:  # pragma: no cover
 
 
 class _FastDistance:
-    """Point-to-segments distance: a plain Python loop for few segments (faster than numpy's
-    per-call overhead), numpy otherwise."""
+    """Exact point-to-segments distance.  A lazily built 64 x 64 grid over the segments'
+    bounding box (grown by 10%) lists, per cell, the only segments that can be nearest to a
+    point of that cell (distance at the cell centre within the nearest one's plus a cell
+    diagonal), so a query is a short Python loop; queries outside the grid check every
+    segment."""
 
     def __init__(self, segs: np.ndarray) -> None:
         self.segs = segs
-        self.small = segs.shape[0] <= 24
-        self.S = None if self.small else Segments(segs)
-        if self.small:
-            self.rows = [
-                (float(x0), float(y0), float(x1 - x0), float(y1 - y0),
-                 1.0 / ((x1 - x0) ** 2 + (y1 - y0) ** 2) if (x1 - x0) or (y1 - y0) else 0.0)
-                for x0, y0, x1, y1 in segs
-            ]
+        self.rows = [
+            (float(x0), float(y0), float(x1 - x0), float(y1 - y0),
+             1.0 / ((x1 - x0) ** 2 + (y1 - y0) ** 2) if (x1 - x0) or (y1 - y0) else 0.0)
+            for x0, y0, x1, y1 in segs
+        ]
+        self.grid = None
 
     def __getstate__(self):
         return {"segs": self.segs}
@@ -502,11 +504,48 @@ class _FastDistance:
     def __setstate__(self, st):
         self.__init__(st["segs"])
 
+    def _build(self, k: int = 64) -> None:
+        segs = self.segs
+        lo = np.minimum(segs[:, :2], segs[:, 2:]).min(axis=0)
+        hi = np.maximum(segs[:, :2], segs[:, 2:]).max(axis=0)
+        pad = 0.05 * (hi - lo) + 1e-9
+        lo, hi = lo - pad, hi + pad
+        h = float(max(hi - lo)) / k
+        nx = max(1, int(math.ceil((hi[0] - lo[0]) / h)))
+        ny = max(1, int(math.ceil((hi[1] - lo[1]) / h)))
+        cx = lo[0] + (np.arange(nx) + 0.5) * h
+        cy = lo[1] + (np.arange(ny) + 0.5) * h
+        X, Y = np.meshgrid(cx, cy, indexing="ij")
+        S = Segments(segs)
+        px = X.reshape(-1, 1) - S.x0
+        py = Y.reshape(-1, 1) - S.y0
+        t = np.clip((px * S.ex + py * S.ey) * S.inv_L2, 0.0, 1.0)
+        d = np.sqrt((px - t * S.ex) ** 2 + (py - t * S.ey) ** 2)
+        cand = d <= d.min(axis=1, keepdims=True) + 2 * h * math.sqrt(0.5) * 1.0001 + 1e-12
+        rows = self.rows
+        cells = [[rows[j] for j in np.flatnonzero(c)] for c in cand]
+        self.grid = (
+            [cells[i * ny:(i + 1) * ny] for i in range(nx)], float(lo[0]), float(lo[1]), 1.0 / h,
+            nx, ny,
+        )
+
     def __call__(self, x: float, y: float) -> float:
-        if not self.small:
-            return self.S.clearance(x, y)
+        if not self.rows:
+            return math.inf
+        if self.grid is None:
+            if len(self.rows) > 8:
+                self._build()
+            else:
+                self.grid = False
+        rows = self.rows
+        if self.grid:
+            G, ox, oy, inv_h, nx, ny = self.grid
+            fi = (x - ox) * inv_h
+            fj = (y - oy) * inv_h
+            if 0.0 <= fi < nx and 0.0 <= fj < ny:
+                rows = G[int(fi)][int(fj)]
         best = math.inf
-        for x0, y0, ex, ey, il2 in self.rows:
+        for x0, y0, ex, ey, il2 in rows:
             px, py = x - x0, y - y0
             t = (px * ex + py * ey) * il2
             if t < 0.0:
