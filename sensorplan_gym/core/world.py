@@ -483,11 +483,11 @@ except ImportError:  # pragma: no cover
 
 
 class _FastDistance:
-    """Exact point-to-segments distance.  A lazily built 64 x 64 grid over the segments'
-    bounding box (grown by 10%) lists, per cell, the only segments that can be nearest to a
-    point of that cell (distance at the cell centre within the nearest one's plus a cell
-    diagonal), so a query is a short Python loop; queries outside the grid check every
-    segment."""
+    """Exact point-to-segments distance.  After 50 queries a 32 x 32 grid over the segments'
+    bounding box (grown by 10%) is built that lists, per cell, the only segments that can be
+    nearest to a point of that cell (distance at the cell centre within the nearest one's
+    plus a cell diagonal), so a query is a short Python loop; queries outside the grid check
+    every segment.  (Lazy, so short-lived worlds such as random scenes pay nothing.)"""
 
     def __init__(self, segs: np.ndarray) -> None:
         self.segs = segs
@@ -497,6 +497,7 @@ class _FastDistance:
             for x0, y0, x1, y1 in segs
         ]
         self.grid = None
+        self.calls = 0
 
     def __getstate__(self):
         return {"segs": self.segs}
@@ -504,7 +505,7 @@ class _FastDistance:
     def __setstate__(self, st):
         self.__init__(st["segs"])
 
-    def _build(self, k: int = 64) -> None:
+    def _build(self, k: int = 32) -> None:
         segs = self.segs
         lo = np.minimum(segs[:, :2], segs[:, 2:]).min(axis=0)
         hi = np.maximum(segs[:, :2], segs[:, 2:]).max(axis=0)
@@ -523,7 +524,10 @@ class _FastDistance:
         d = np.sqrt((px - t * S.ex) ** 2 + (py - t * S.ey) ** 2)
         cand = d <= d.min(axis=1, keepdims=True) + 2 * h * math.sqrt(0.5) * 1.0001 + 1e-12
         rows = self.rows
-        cells = [[rows[j] for j in np.flatnonzero(c)] for c in cand]
+        ci, sj = np.nonzero(cand)
+        cells: list[list] = [[] for _ in range(cand.shape[0])]
+        for i, j in zip(ci.tolist(), sj.tolist()):
+            cells[i].append(rows[j])
         self.grid = (
             [cells[i * ny:(i + 1) * ny] for i in range(nx)], float(lo[0]), float(lo[1]), 1.0 / h,
             nx, ny,
@@ -533,10 +537,11 @@ class _FastDistance:
         if not self.rows:
             return math.inf
         if self.grid is None:
-            if len(self.rows) > 8:
-                self._build()
-            else:
+            self.calls += 1
+            if len(self.rows) <= 8:
                 self.grid = False
+            elif self.calls > 50:
+                self._build()
         rows = self.rows
         if self.grid:
             G, ox, oy, inv_h, nx, ny = self.grid
@@ -569,13 +574,14 @@ def _anchor(g: shapely.Geometry) -> tuple[float, float]:
     return (float(c.x), float(c.y))
 
 
-def _key(scene: Scene, cfg: WorldConfig) -> tuple:
-    return (json.dumps(scene.to_dict(), sort_keys=True), cfg)
+def _key(scene: Scene, cfg: WorldConfig, data: dict | None = None) -> tuple:
+    return (json.dumps(scene.to_dict() if data is None else data, sort_keys=True), cfg)
 
 
-def get_world(scene: Scene, cfg: WorldConfig) -> World:
-    """The cached :class:`World` for ``(scene, cfg)`` (LRU of 64 entries)."""
-    key = _key(scene, cfg)
+def get_world(scene: Scene, cfg: WorldConfig, data: dict | None = None) -> World:
+    """The cached :class:`World` for ``(scene, cfg)`` (LRU of 64 entries).  ``data``: the
+    scene's JSON dict when the caller has it (saves a deep copy)."""
+    key = _key(scene, cfg, data)
     w = _CACHE.get(key)
     if w is not None:
         _CACHE.move_to_end(key)

@@ -175,8 +175,8 @@ class SensorPlanEnv(gym.Env):
         for _ in range(self.max_scene_tries):
             d = random_scene(rng, **self.random_scene_kwargs)
             scene = Scene.from_dict(d)
-            world = get_world(scene, self.cfg)
-            start = self._start_pose(world, rng) if True else None
+            world = get_world(scene, self.cfg, d)
+            start = self._start_pose(world, rng)
             last = self._scene_problem(world, start)
             if last is None:
                 return world, start
