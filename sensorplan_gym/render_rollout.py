@@ -53,11 +53,14 @@ def contact_sheet(frames: list[np.ndarray], n: int, cols: int) -> np.ndarray:
     pick = [frames[i] for i in idx]
     h, w, _ = pick[0].shape
     rows = -(-len(pick) // cols)
-    sheet = np.full((rows * h + (rows - 1) * 4, min(cols, len(pick)) * w + (min(cols, len(pick)) - 1) * 4, 3),
-                    255, np.uint8)
+    sheet = np.full(
+        (rows * h + (rows - 1) * 4, min(cols, len(pick)) * w + (min(cols, len(pick)) - 1) * 4, 3),
+        255,
+        np.uint8,
+    )
     for k, f in enumerate(pick):
         r, c = divmod(k, cols)
-        sheet[r * (h + 4): r * (h + 4) + h, c * (w + 4): c * (w + 4) + w] = f
+        sheet[r * (h + 4) : r * (h + 4) + h, c * (w + 4) : c * (w + 4) + w] = f
     return sheet
 
 

@@ -72,7 +72,7 @@ def _rollout(env, seed, n=40):
 
 def _same(a, b):
     assert len(a) == len(b)
-    for x, y in zip(a, b):
+    for x, y in zip(a, b, strict=True):
         if isinstance(x, tuple):
             np.testing.assert_array_equal(x[0], y[0])
             assert x[1:] == y[1:]
@@ -166,8 +166,9 @@ def test_pickle_roundtrip(env_id):
 
 
 def test_make_vec_async():
-    envs = gym.make_vec("sensorplan_gym:sensorplan/Navigate-v0", num_envs=2,
-                        vectorization_mode="async")
+    envs = gym.make_vec(
+        "sensorplan_gym:sensorplan/Navigate-v0", num_envs=2, vectorization_mode="async"
+    )
     try:
         obs, info = envs.reset(seed=0)
         assert obs.shape == (2, *envs.single_observation_space.shape)
@@ -183,8 +184,9 @@ def test_sb3_subproc_vec_env():
     from stable_baselines3.common.env_util import make_vec_env
     from stable_baselines3.common.vec_env import SubprocVecEnv
 
-    venv = make_vec_env("sensorplan_gym:sensorplan/Recognize-v0", n_envs=2,
-                        vec_env_cls=SubprocVecEnv)
+    venv = make_vec_env(
+        "sensorplan_gym:sensorplan/Recognize-v0", n_envs=2, vec_env_cls=SubprocVecEnv
+    )
     try:
         venv.reset()
         for _ in range(5):
@@ -197,8 +199,10 @@ def test_make_without_prior_import():
     import subprocess
     import sys
 
-    code = ("import gymnasium as gym; e = gym.make('sensorplan_gym:sensorplan/Placement-v0'); "
-            "e.reset(seed=0); print('ok')")
+    code = (
+        "import gymnasium as gym; e = gym.make('sensorplan_gym:sensorplan/Placement-v0'); "
+        "e.reset(seed=0); print('ok')"
+    )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
     assert out.stdout.strip() == "ok", out.stderr
 
@@ -297,7 +301,7 @@ def test_recognize_rewards_and_no_leak():
 def test_recognize_timeout_is_wrong():
     env = _make("sensorplan/Recognize-v0", scene="lab", max_steps=5)
     env.reset(seed=0)
-    for i in range(5):
+    for _ in range(5):
         _, r, te, tr, info = env.step(np.array([0.0, 0.0, 0.1, 0.0]))
     assert tr and not te and r == pytest.approx(-1.0 - 0.01) and not info["is_success"]
     assert info["target_in"] in ("G", "H")
@@ -328,8 +332,9 @@ def _pv_visibility(free, p):
         comp = next(g for g in comp.geoms if g.covers(shapely.Point(p)))
     comp = shapely.geometry.polygon.orient(comp, 1.0)
     ext = [pv.Point(float(x), float(y)) for x, y in np.asarray(comp.exterior.coords)[:-1]]
-    holes = [[pv.Point(float(x), float(y)) for x, y in np.asarray(r.coords)[:-1]]
-             for r in comp.interiors]
+    holes = [
+        [pv.Point(float(x), float(y)) for x, y in np.asarray(r.coords)[:-1]] for r in comp.interiors
+    ]
     P = pv.PolygonWithHoles(ext, holes) if holes else pv.PolygonWithHoles(ext)
     vp = pv.VisibilityPolygonCalculator(P).compute_visibility_polygon(pv.Point(*p))
     return shapely.Polygon([(float(q.x()), float(q.y())) for q in vp.boundary()])

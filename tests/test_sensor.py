@@ -52,7 +52,9 @@ def test_cast_matches_shapely(lab):
 def test_fov_max_range_and_noise(lab):
     w = lab
     s = RangeSensor(5, math.radians(90), 1.0)
-    assert s.offsets[0] == pytest.approx(-math.pi / 4) and s.offsets[-1] == pytest.approx(math.pi / 4)
+    assert s.offsets[0] == pytest.approx(-math.pi / 4) and s.offsets[-1] == pytest.approx(
+        math.pi / 4
+    )
     d, n, h, _ = s.read((6.0, 4.0, 0.0), w.seg_set)
     assert (d <= 1.0).all()
     assert np.all(n[~h] == 0) and np.all(d[~h] == 1.0)

@@ -73,23 +73,33 @@ class RobotVectorObs:
         k = world._cache.get("obs_consts")
         if k is None:
             k = world._cache["obs_consts"] = (
-                float(world.lo[0]), float(world.lo[1]),
-                2.0 / float(world.hi[0] - world.lo[0]), 2.0 / float(world.hi[1] - world.lo[1]),
-                1.0 / world.diameter, 1.0 / world.reach,
-                float(world.goal_center[0]), float(world.goal_center[1]),
-                float(world.failure_center[0]), float(world.failure_center[1]),
+                float(world.lo[0]),
+                float(world.lo[1]),
+                2.0 / float(world.hi[0] - world.lo[0]),
+                2.0 / float(world.hi[1] - world.lo[1]),
+                1.0 / world.diameter,
+                1.0 / world.reach,
+                float(world.goal_center[0]),
+                float(world.goal_center[1]),
+                float(world.failure_center[0]),
+                float(world.failure_center[1]),
             )
         lx, ly, sx, sy, inv, inv_reach, Gx, Gy, Hx, Hy = k
         gx, gy, hx, hy = Gx - x, Gy - y, Hx - x, Hy - y
         px = (x - lx) * sx - 1.0
         py = (y - ly) * sy - 1.0
-        head = np.array([
-            -1.0 if px < -1.0 else (1.0 if px > 1.0 else px),
-            -1.0 if py < -1.0 else (1.0 if py > 1.0 else py),
-            c, s,
-            (c * gx + s * gy) * inv, (-s * gx + c * gy) * inv,
-            (c * hx + s * hy) * inv, (-s * hx + c * hy) * inv,
-        ])
+        head = np.array(
+            [
+                -1.0 if px < -1.0 else (1.0 if px > 1.0 else px),
+                -1.0 if py < -1.0 else (1.0 if py > 1.0 else py),
+                c,
+                s,
+                (c * gx + s * gy) * inv,
+                (-s * gx + c * gy) * inv,
+                (c * hx + s * hy) * inv,
+                (-s * hx + c * hy) * inv,
+            ]
+        )
         nr = (nrm @ np.array([[c, -s], [s, c]])).T.ravel()  # robot-frame x's, then y's
         # every entry is within its bounds up to rounding of order 1e-16, which the float32
         # conversion absorbs (values within 2**-25 of +-1 round to +-1)

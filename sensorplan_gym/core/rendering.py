@@ -82,8 +82,9 @@ class Renderer:
         ax.add_patch(room)
         region_path = _path(world.region)
         if region_path is not None:
-            ax.add_patch(PathPatch(region_path, fc="#7fd37f", ec="#2e8b2e", lw=0.6, alpha=0.55,
-                                   zorder=1))
+            ax.add_patch(
+                PathPatch(region_path, fc="#7fd37f", ec="#2e8b2e", lw=0.6, alpha=0.55, zorder=1)
+            )
         for o in scene.obstacles:
             ax.add_patch(PathPatch(_path(Polygon(o)), fc="#454545", ec="black", lw=0.8, zorder=2))
         for g, color, label in (
@@ -97,13 +98,22 @@ class Renderer:
                 ax.add_patch(PathPatch(_path(g), fc=color, ec=color, alpha=0.45, lw=1, zorder=3))
                 c = g.centroid
                 tx, ty = c.x, c.y
-            ax.text(tx, ty + 0.03 * span, label, color=color, ha="center", va="bottom",
-                    fontsize=11, fontweight="bold")
+            ax.text(
+                tx,
+                ty + 0.03 * span,
+                label,
+                color=color,
+                ha="center",
+                va="bottom",
+                fontsize=11,
+                fontweight="bold",
+            )
 
         tgt = state.get("target")
         if tgt is not None:
-            ax.add_patch(PathPatch(_path(Polygon(tgt)), fc="none", ec="#7a2fbf", lw=1.4, ls="--",
-                                   zorder=3))
+            ax.add_patch(
+                PathPatch(_path(Polygon(tgt)), fc="none", ec="#7a2fbf", lw=1.4, ls="--", zorder=3)
+            )
 
         pose = state.get("pose")
         if pose is not None:
@@ -113,9 +123,16 @@ class Renderer:
             fov = world.fov
             R = world.reach
             if fov < 2 * math.pi - 1e-9:
-                wedge = Wedge((sx, sy), R, math.degrees(spsi - fov / 2),
-                              math.degrees(spsi + fov / 2), fc="#ffcc66", ec="none", alpha=0.3,
-                              zorder=0.5)
+                wedge = Wedge(
+                    (sx, sy),
+                    R,
+                    math.degrees(spsi - fov / 2),
+                    math.degrees(spsi + fov / 2),
+                    fc="#ffcc66",
+                    ec="none",
+                    alpha=0.3,
+                    zorder=0.5,
+                )
                 ax.add_patch(wedge)
                 wedge.set_clip_path(room)
             scan = state.get("scan")
@@ -124,26 +141,42 @@ class Renderer:
                 ex = sx + dist * np.cos(ang)
                 ey = sy + dist * np.sin(ang)
                 segs = np.stack(
-                    [np.stack([np.full_like(ex, sx), ex], 1), np.stack([np.full_like(ey, sy), ey], 1)],
+                    [
+                        np.stack([np.full_like(ex, sx), ex], 1),
+                        np.stack([np.full_like(ey, sy), ey], 1),
+                    ],
                     axis=2,
                 )
                 from matplotlib.collections import LineCollection
 
-                ax.add_collection(LineCollection(segs, colors="#e08a00", linewidths=0.6, alpha=0.8,
-                                                 zorder=4))
+                ax.add_collection(
+                    LineCollection(segs, colors="#e08a00", linewidths=0.6, alpha=0.8, zorder=4)
+                )
                 hit = scan[2]
                 ax.plot(ex[hit], ey[hit], ".", ms=2.5, color="#b35f00", zorder=4)
             rr = max(world.robot_radius, 0.012 * span)
             rec = state.get("recognizing", False)
-            ax.add_patch(Circle((x, y), rr, fc="#2e8b2e" if rec else "#ff8c1a", ec="black", lw=1,
-                                zorder=5))
-            ax.plot([x, x + 1.8 * rr * math.cos(psi)], [y, y + 1.8 * rr * math.sin(psi)],
-                    color="black", lw=1.5, zorder=6)
+            ax.add_patch(
+                Circle((x, y), rr, fc="#2e8b2e" if rec else "#ff8c1a", ec="black", lw=1, zorder=5)
+            )
+            ax.plot(
+                [x, x + 1.8 * rr * math.cos(psi)],
+                [y, y + 1.8 * rr * math.sin(psi)],
+                color="black",
+                lw=1.5,
+                zorder=6,
+            )
         title = state.get("title")
         if title:
-            ax.text(cx - half + 0.02 * span, cy + half - 0.02 * span, title, va="top",
-                    fontsize=9, family="monospace",
-                    bbox=dict(fc="white", ec="none", alpha=0.7))
+            ax.text(
+                cx - half + 0.02 * span,
+                cy + half - 0.02 * span,
+                title,
+                va="top",
+                fontsize=9,
+                family="monospace",
+                bbox=dict(fc="white", ec="none", alpha=0.7),
+            )
         fig.canvas.draw()
         buf = np.asarray(fig.canvas.buffer_rgba())
         return np.ascontiguousarray(buf[:, :, :3])

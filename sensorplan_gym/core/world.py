@@ -308,9 +308,7 @@ class World:
             comps = getattr(self.robot_space, "geoms", [self.robot_space])
             pt = Point(start_xy)
             comp = next((c for c in comps if c.intersects(pt)), None)
-            self._cache[key] = (
-                shapely.Polygon() if comp is None else self.region.intersection(comp)
-            )
+            self._cache[key] = shapely.Polygon() if comp is None else self.region.intersection(comp)
         return self._cache[key]
 
     def triangles(self, which: str) -> tuple[np.ndarray, np.ndarray]:
@@ -445,7 +443,7 @@ class World:
         key = f"raster{size}"
         if key not in self._cache:
             scale, ox, oy = self.grid_transform(size)
-            ij = (np.arange(size) + 0.5)
+            ij = np.arange(size) + 0.5
             X, Y = np.meshgrid(ox + ij / scale, oy + (size - ij) / scale)
             out = np.zeros((3, size, size), dtype=np.uint8)
             out[0] = np.where(shapely.contains_xy(self.free_space, X, Y), 0, 255)
@@ -492,8 +490,13 @@ class _FastDistance:
     def __init__(self, segs: np.ndarray) -> None:
         self.segs = segs
         self.rows = [
-            (float(x0), float(y0), float(x1 - x0), float(y1 - y0),
-             1.0 / ((x1 - x0) ** 2 + (y1 - y0) ** 2) if (x1 - x0) or (y1 - y0) else 0.0)
+            (
+                float(x0),
+                float(y0),
+                float(x1 - x0),
+                float(y1 - y0),
+                1.0 / ((x1 - x0) ** 2 + (y1 - y0) ** 2) if (x1 - x0) or (y1 - y0) else 0.0,
+            )
             for x0, y0, x1, y1 in segs
         ]
         self.grid = None
@@ -526,11 +529,15 @@ class _FastDistance:
         rows = self.rows
         ci, sj = np.nonzero(cand)
         cells: list[list] = [[] for _ in range(cand.shape[0])]
-        for i, j in zip(ci.tolist(), sj.tolist()):
+        for i, j in zip(ci.tolist(), sj.tolist(), strict=True):
             cells[i].append(rows[j])
         self.grid = (
-            [cells[i * ny:(i + 1) * ny] for i in range(nx)], float(lo[0]), float(lo[1]), 1.0 / h,
-            nx, ny,
+            [cells[i * ny : (i + 1) * ny] for i in range(nx)],
+            float(lo[0]),
+            float(lo[1]),
+            1.0 / h,
+            nx,
+            ny,
         )
 
     def __call__(self, x: float, y: float) -> float:

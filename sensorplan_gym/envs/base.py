@@ -87,8 +87,12 @@ class SensorPlanEnv(gym.Env):
                 f"got {render_mode!r}"
             )
         self.render_mode = render_mode
-        for name, v in (("eps_pos", eps_pos), ("eps_aim", eps_aim), ("fov_deg", fov_deg),
-                        ("max_range", max_range)):
+        for name, v in (
+            ("eps_pos", eps_pos),
+            ("eps_aim", eps_aim),
+            ("fov_deg", fov_deg),
+            ("max_range", max_range),
+        ):
             if v is not None and not isinstance(v, (int, float)):
                 raise ValueError(f"{name} must be a number or None, got {v!r}")
         if not isinstance(noise, (int, float)) or not math.isfinite(noise) or noise < 0:
@@ -126,8 +130,9 @@ class SensorPlanEnv(gym.Env):
             self.start = self._start_pose(self.world, np.random.default_rng(0))
             problem = self._scene_problem(self.world, self.start)
             if problem:
-                raise ValueError(f"scene {self._scene.name!r} unusable for {type(self).__name__}: "
-                                 f"{problem}")
+                raise ValueError(
+                    f"scene {self._scene.name!r} unusable for {type(self).__name__}: {problem}"
+                )
         self._renderer = Renderer() if render_mode is not None else None
         self._viewer = HumanViewer() if render_mode == "human" else None
         self.pose: tuple[float, float, float] | None = None
@@ -231,7 +236,9 @@ class SensorPlanEnv(gym.Env):
         try:
             a = np.asarray(action, dtype=np.float64)
         except (TypeError, ValueError) as e:
-            raise ValueError(f"action must be a numeric array of shape {shape}, got {action!r}") from e
+            raise ValueError(
+                f"action must be a numeric array of shape {shape}, got {action!r}"
+            ) from e
         if a.shape != shape:
             raise ValueError(f"action must have shape {shape}, got shape {a.shape}")
         vals = a.tolist()
@@ -305,10 +312,18 @@ class RobotEnv(SensorPlanEnv):
     ``info["collided"]`` is True.  Out-of-range components are clipped to [-1, 1].
     """
 
-    def __init__(self, scene="lab", *, max_speed: float | None = None,
-                 max_turn: float = math.pi / 8, **kwargs) -> None:
+    def __init__(
+        self,
+        scene="lab",
+        *,
+        max_speed: float | None = None,
+        max_turn: float = math.pi / 8,
+        **kwargs,
+    ) -> None:
         for name, v in (("max_speed", max_speed), ("max_turn", max_turn)):
-            if v is not None and (not isinstance(v, (int, float)) or not math.isfinite(v) or v <= 0):
+            if v is not None and (
+                not isinstance(v, (int, float)) or not math.isfinite(v) or v <= 0
+            ):
                 raise ValueError(f"{name} must be a positive number, got {v!r}")
         self._max_speed_cfg = max_speed
         self.max_turn = float(max_turn)

@@ -46,8 +46,15 @@ __all__ = ["NavigateEnv"]
 class NavigateEnv(RobotEnv):
     obs_kind = "robot"
 
-    def __init__(self, scene="lab", *, step_cost: float = 0.01, success_bonus: float = 1.0,
-                 shaping: float = 0.0, **kwargs) -> None:
+    def __init__(
+        self,
+        scene="lab",
+        *,
+        step_cost: float = 0.01,
+        success_bonus: float = 1.0,
+        shaping: float = 0.0,
+        **kwargs,
+    ) -> None:
         self.step_cost = float(step_cost)
         self.success_bonus = float(success_bonus)
         self.shaping = float(shaping)

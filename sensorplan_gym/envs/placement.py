@@ -77,8 +77,14 @@ class PlacementEnv(SensorPlanEnv):
         reward = float(success)
         if self.shaping and math.isfinite(dist):
             reward -= self.shaping * dist / w.diameter
-        return {"reward": reward, "is_success": success, "recognizing": success,
-                "in_region": in_region, "aim_ok": aim_ok, "distance_to_region": dist}
+        return {
+            "reward": reward,
+            "is_success": success,
+            "recognizing": success,
+            "in_region": in_region,
+            "aim_ok": aim_ok,
+            "distance_to_region": dist,
+        }
 
     def _reset_episode(self, options: dict) -> None:
         self.pose = None
@@ -104,5 +110,4 @@ class PlacementEnv(SensorPlanEnv):
         return self._obs(self.world)
 
     def _info(self) -> dict[str, Any]:
-        return {"is_success": False, "recognizing": False,
-                "distance_to_region": math.inf}
+        return {"is_success": False, "recognizing": False, "distance_to_region": math.inf}

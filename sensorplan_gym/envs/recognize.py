@@ -48,8 +48,9 @@ __all__ = ["RecognizeEnv"]
 class RecognizeEnv(RobotEnv):
     obs_kind = "robot"
 
-    def __init__(self, scene="lab", *, step_cost: float = 0.01, max_steps: int | None = None,
-                 **kwargs) -> None:
+    def __init__(
+        self, scene="lab", *, step_cost: float = 0.01, max_steps: int | None = None, **kwargs
+    ) -> None:
         self.step_cost = float(step_cost)
         if max_steps is not None and (not isinstance(max_steps, int) or max_steps < 1):
             raise ValueError(f"max_steps must be a positive integer or None, got {max_steps!r}")
@@ -140,4 +141,3 @@ def _clear(p, poly: np.ndarray, segs: np.ndarray, r: float) -> bool:
     """The robot disc at ``p`` does not meet the target polygon."""
     P = shapely.Polygon(poly)
     return P.distance(shapely.Point(p)) > r + 1e-9
-
