@@ -429,3 +429,21 @@ def test_render_rollout_png(tmp_path):
 
     img = matplotlib.image.imread(out)
     assert img.ndim == 3 and img.shape[0] > 100 and img.shape[1] > 200
+
+
+@pytest.mark.parametrize("motion", ["stationary", "translating", "rotating"])
+def test_motions_complete_model(motion):
+    env = _make("sensorplan/Recognize-v0", scene="lab", motion=motion, eps_pos=0.05).unwrapped
+    sides = set()
+    for seed in range(6):
+        env.reset(seed=seed)
+        sides.add(env._side)
+        tgt = shapely.Polygon(env._target_poly)
+        region = env.world.goal_geom if env._side == "G" else env.world.failure_geom
+        # the target's reference point lies in its region: A_q within r_A of the region
+        assert region.buffer(env.world.target_radius + 1e-9).covers(tgt)
+        env.step(np.array([0.5, 0.0, 0.2, 0.0]))
+    assert sides == {"G", "H"}
+    if motion == "stationary":
+        assert env.world.goal_geom.geom_type == "Point"
+    assert (env.world.theta is None) == (motion == "rotating")
