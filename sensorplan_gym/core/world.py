@@ -421,6 +421,14 @@ class World:
                 return False
         return True
 
+    def query(self, x: float, y: float, psi: float) -> tuple[bool, float]:
+        """``(recognizing, distance_to_region)`` with one point-in-region test."""
+        if not self.region_segs.shape[0]:
+            return False, math.inf
+        if _contains_xy(self.region, x, y):
+            return self.aim_ok(x, y, psi), 0.0
+        return False, self._region_fast(x, y)
+
     def recognizing(self, x: float, y: float, psi: float) -> bool:
         """The pose tells G from H: placement in the recognizable region and aim OK."""
         return self.in_region(x, y) and self.aim_ok(x, y, psi)

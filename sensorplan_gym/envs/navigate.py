@@ -82,8 +82,7 @@ class NavigateEnv(RobotEnv):
         self._read_sensor(self.pose)
         x, y, psi = self.pose
         w = self.world
-        recognizing = w.recognizing(x, y, psi)
-        dist = w.distance_to_region(x, y)
+        recognizing, dist = w.query(x, y, psi)
         reward = -self.step_cost
         if self.shaping and math.isfinite(dist) and math.isfinite(self._dist):
             reward += self.shaping * (self._dist - dist) / w.diameter

@@ -119,12 +119,12 @@ class RecognizeEnv(RobotEnv):
 
     def _info(self) -> dict[str, Any]:
         x, y, psi = self.pose
-        w = self.world
+        recognizing, dist = self.world.query(x, y, psi)
         return {
             "is_success": self._declared is not None and self._declared == self._side,
             "declared": self._declared,
-            "recognizing": w.recognizing(x, y, psi),
-            "distance_to_region": w.distance_to_region(x, y),
+            "recognizing": recognizing,
+            "distance_to_region": dist,
             "collided": self._collided,
             "pose": self.pose,
         }
