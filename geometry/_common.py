@@ -177,24 +177,44 @@ def shrink_for_position(region: shapely.Geometry, allowed: shapely.Geometry, eps
     shadows are ``allowed - region``.  The result keeps the points of ``region``
     whose whole eps-disc, within ``allowed``, lies in ``region``.  The disc is a
     polygon circumscribing the true disc, so the result is conservative: it lies
-    inside the exact region, within ``eps_pos * (1/cos(pi/64) - 1)`` of it.
+    inside the exact region, within ``eps_pos * (1/cos(pi/64) - 1)`` of it.  Shadow
+    slivers thinner than 2e-9 of the scene's diagonal (float noise of the boolean
+    operations) are ignored.
     """
     if eps_pos <= 0 or region.is_empty:
         return region
-    shadows = shapely.difference(allowed, region)
-    grown = shapely.buffer(shadows, eps_pos * OUTER, quad_segs=QUAD_SEGS)
+    shadows = _polygonal(shapely.difference(allowed, region))
+    # open the shadows by a float-noise width first: the difference leaves 1e-16-wide
+    # slivers along obstacle edges, which must not grow into eps-wide bands
+    delta = 1e-9 * max(_diag(allowed), 1.0)
+    shadows = shapely.buffer(shadows, -delta, join_style="mitre")
+    grown = shapely.buffer(shadows, eps_pos * OUTER + 2 * delta, quad_segs=QUAD_SEGS)
     return _polygonal(shapely.difference(region, grown))
 
 
+def _diag(g: shapely.Geometry) -> float:
+    x0, y0, x1, y1 = g.bounds
+    return float(np.hypot(x1 - x0, y1 - y0))
+
+
 def _polygonal(g: shapely.Geometry) -> shapely.Geometry:
-    """Drop lower-dimensional debris from a boolean result."""
-    if g.geom_type in ("Polygon", "MultiPolygon") or g.is_empty:
-        return g
+    """Keep the areal parts of a boolean result, dropping debris: points, lines and
+    slivers of float noise (parts whose area is below 1e-10 of their squared
+    perimeter, e.g. a 1e-16-wide strip along an obstacle edge).  An answer with
+    nothing left is an empty Polygon."""
+    if g.is_empty:
+        return shapely.Polygon()
     parts = shapely.get_parts(g)
     parts = parts[np.isin(shapely.get_type_id(parts), (3, 6))]
+    if len(parts) and parts[0].geom_type == "MultiPolygon":
+        parts = shapely.get_parts(parts)
+    if len(parts):
+        parts = parts[shapely.area(parts) > 1e-10 * shapely.length(parts) ** 2]
     if len(parts) == 0:
         return shapely.Polygon()
-    return shapely.union_all(parts)
+    if len(parts) == 1:
+        return parts[0]
+    return shapely.multipolygons(parts)
 
 
 polygonal = _polygonal

@@ -173,61 +173,57 @@ def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
 
 
-def local_wedge(dom: Domain, q: np.ndarray) -> tuple[float, float] | None:
-    """Free wedge ``(start, width)`` at ``q`` if ``q`` is a domain vertex, else None.
-
-    The free directions at a boundary vertex run counter-clockwise from the
-    direction of the next vertex to the direction of the previous one.
-    """
-    tol = 1e-12 * dom.scale
-    hit = np.flatnonzero(np.abs(dom.vert - q).max(axis=1) <= tol)
-    if len(hit) == 0:
-        return None
-    i = hit[0]
-    a = np.arctan2(*(dom.vert_next[i] - q)[::-1])
-    b = np.arctan2(*(dom.vert_prev[i] - q)[::-1])
-    width = (b - a) % TAU
-    if width == 0.0:
-        width = TAU
-    return float(a), float(width)
-
-
 def gaps_from(
     dom: Domain,
     q: np.ndarray,
     *,
     sector: tuple[float, float] | None = None,
     extra: np.ndarray | None = None,
-    wedge: tuple[float, float] | None | bool = True,
 ) -> Gaps:
     """Angular gaps of the visibility of ``q`` in ``dom``.
 
     Parameters
     ----------
-    q : viewpoint (x, y), world frame.
+    q : viewpoint (x, y), world frame.  It may lie on the boundary: directions that
+        enter an obstacle right at ``q`` are blocked (``seg == -1``).
     sector : optional ``(start, width)`` in radians; only directions inside it are
         resolved (the gaps cover exactly the sector).
     extra : additional critical directions (radians) to split gaps at.
-    wedge : ``True`` to detect whether ``q`` is a domain vertex and block the
-        directions that point into the boundary there (``seg == -1``); an
-        explicit ``(start, width)`` free wedge; or ``None``/``False`` for an
-        interior point.
     """
     q = np.asarray(q, dtype=float)[None, :]
-    if wedge is True:
-        w = local_wedge(dom, q[0])
-    elif wedge is False:
-        w = None
-    else:
-        w = wedge
     ex = None if extra is None else np.asarray(extra, dtype=float).reshape(1, -1)
-    return gaps_many(
-        dom,
-        q,
-        sectors=None if sector is None else np.asarray([sector], dtype=float),
-        wedges=None if w is None else np.asarray([w], dtype=float),
-        extra=ex,
-    )[0]
+    sec = None if sector is None else np.asarray([sector], dtype=float)
+    return gaps_many(dom, q, sectors=sec, extra=ex)[0]
+
+
+def _blocking(dom: Domain, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Local obstruction at viewpoints on the boundary: for each of the (n, 2) points,
+    the free wedges ``(start, width)`` of up to two domain vertices it coincides with
+    (NaN rows when none) and the direction of a segment whose interior contains it
+    (NaN when none).  Directions outside a wedge, or to the right of such a segment,
+    enter an obstacle at once."""
+    tol = 1e-12 * dom.scale
+    n = len(q)
+    near = np.abs(dom.vert[None, :, :] - q[:, None, :]).max(axis=2) <= tol
+    w1 = np.full((n, 2), np.nan)
+    w2 = np.full((n, 2), np.nan)
+    rows, cols = np.nonzero(near)
+    if len(rows):
+        wedge = dom.vert_wedge
+        first = np.concatenate([[True], rows[1:] != rows[:-1]])
+        w1[rows[first]] = wedge[cols[first]]
+        second = ~first & np.concatenate([[False], first[:-1]])
+        w2[rows[second]] = wedge[cols[second]]
+    e = dom.seg[:, 2:] - dom.seg[:, :2]
+    L = np.hypot(e[:, 0], e[:, 1])
+    a = q[:, None, :] - dom.seg[None, :, :2]
+    dist = np.abs(e[None, :, 0] * a[..., 1] - e[None, :, 1] * a[..., 0]) / np.maximum(L, 1e-300)
+    t = (a[..., 0] * e[None, :, 0] + a[..., 1] * e[None, :, 1]) / np.maximum(L * L, 1e-300)
+    on = (dist <= tol) & (t * L > tol) & ((1 - t) * L > tol)
+    along = np.full((n, 2), np.nan)
+    r2, c2 = np.nonzero(on)
+    along[r2] = e[c2]
+    return w1, w2, along
 
 
 def gaps_many(
@@ -235,20 +231,20 @@ def gaps_many(
     q: np.ndarray,
     *,
     sectors: np.ndarray | None = None,
-    wedges: np.ndarray | None = None,
     extra: np.ndarray | None = None,
     flat: bool = False,
 ) -> list[Gaps] | tuple[Gaps, np.ndarray]:
     """:func:`gaps_from` for many viewpoints at once (one vectorised ray cast).
 
-    ``q`` is (n, 2); ``sectors`` and ``wedges`` are (n, 2) arrays of
-    ``(start, width)`` (a NaN row means no restriction); ``extra`` is (n, k)
-    extra critical directions (NaN entries ignored).
+    ``q`` is (n, 2); ``sectors`` is an (n, 2) array of ``(start, width)`` (a NaN
+    row means the full circle); ``extra`` is (n, k) extra critical directions (NaN
+    entries ignored).
 
     Returns one :class:`Gaps` per viewpoint, or with ``flat=True`` all gaps in
     one :class:`Gaps` (``q`` then holds one row per gap) plus the (n+1,) offsets
     of each viewpoint's gaps.
     """
+    q = np.asarray(q, dtype=float).reshape(-1, 2)
     n = len(q)
     tol = 1e-12 * dom.scale
     start = np.zeros(n)
@@ -257,12 +253,14 @@ def gaps_many(
         has = ~np.isnan(sectors[:, 0])
         start[has] = sectors[has, 0]
         width[has] = np.minimum(sectors[has, 1], TAU)
+    w1, w2, along = _blocking(dom, q)
     d = dom.vert[None, :, :] - q[:, None, :]
     cols = [np.where(np.abs(d).max(axis=2) > tol, np.arctan2(d[..., 1], d[..., 0]), np.nan)]
     if extra is not None:
         cols.append(extra)
-    if wedges is not None:
-        cols.append(np.stack([wedges[:, 0], wedges[:, 0] + wedges[:, 1]], axis=1))
+    cols.append(np.stack([w1[:, 0], w1[:, 0] + w1[:, 1], w2[:, 0], w2[:, 0] + w2[:, 1],
+                          np.arctan2(along[:, 1], along[:, 0]),
+                          np.arctan2(-along[:, 1], -along[:, 0])], axis=1))
     ang = np.concatenate(cols, axis=1)
     rel = (ang - start[:, None]) % TAU
     rel = np.where(np.isnan(rel) | (rel >= width[:, None]) | (rel <= 0.0), np.inf, rel)
@@ -275,10 +273,13 @@ def gaps_many(
     hi = start[owner] + hi_r[owner, col]
     mid = 0.5 * (lo + hi)
     open_ = np.ones(len(mid), dtype=bool)
-    if wedges is not None:
-        w0 = wedges[owner, 0]
-        inw = ((mid - w0) % TAU) < wedges[owner, 1]
-        open_ &= np.isnan(w0) | inw
+    for w in (w1, w2):
+        w0 = w[owner, 0]
+        with np.errstate(invalid="ignore"):
+            open_ &= np.isnan(w0) | (((mid - w0) % TAU) < w[owner, 1])
+    ax, ay = along[owner, 0], along[owner, 1]
+    with np.errstate(invalid="ignore"):
+        open_ &= np.isnan(ax) | (ax * np.sin(mid) - ay * np.cos(mid) >= 0)
     qo = q[owner]
     seg = np.full(len(mid), -1, dtype=np.int64)
     idx = np.flatnonzero(open_)

@@ -120,8 +120,7 @@ def weak_visibility(env: Domain, ring: np.ndarray, wanted: np.ndarray, eps_aim: 
         dirs = np.stack([e_out, e_in], axis=1)  # (k, 2, 2)
         ang = np.arctan2(dirs[..., 1], dirs[..., 0])
         extra = np.concatenate([ang + np.pi, ang], axis=1)
-        wedges = dom.vert_wedge[len(env.vert) + anchors]
-        for gi, i in zip(gaps_many(dom, ring[anchors], wedges=wedges, extra=extra), anchors):
+        for gi, i in zip(gaps_many(dom, ring[anchors], extra=extra), anchors):
             mid = 0.5 * (gi.lo + gi.hi)
             d = np.stack([np.cos(mid), np.sin(mid)], axis=1)
             front = np.zeros(len(mid), dtype=bool)
@@ -142,20 +141,18 @@ def weak_visibility(env: Domain, ring: np.ndarray, wanted: np.ndarray, eps_aim: 
         lo = np.where(on_target, np.inf, rel).min(axis=1)
         hi = np.where(on_target, -np.inf, rel).max(axis=1)
         ok = hi - lo > 1e-12
-        vw = dom.vert_wedge[dom.reflex][ok]
         v, sectors = v[ok], np.stack([base[ok] + lo[ok], hi[ok] - lo[ok]], axis=1)
-        g, off = gaps_many(dom, v, sectors=sectors, wedges=vw, flat=True)
+        g, off = gaps_many(dom, v, sectors=sectors, flat=True)
         sees = (g.seg >= 0) & (dom.seg_tag[np.maximum(g.seg, 0)] == WANTED)
-        back_q, back_sec, back_w = [], [], []
+        back_q, back_sec = [], []
         for k in np.unique(np.searchsorted(off, np.flatnonzero(sees), side="right") - 1):
             gk = g.part(off[k], off[k + 1])
             for run in _runs(gk, sees[off[k] : off[k + 1]]):
                 back_q.append(v[k])
                 back_sec.append((gk.lo[run[0]] + np.pi, _width(gk, run)))
-                back_w.append(vw[k])
         # ... then the placements on the opposite side of v
         if back_q:
-            backs = gaps_many(dom, np.asarray(back_q), sectors=np.asarray(back_sec), wedges=np.asarray(back_w))
+            backs = gaps_many(dom, np.asarray(back_q), sectors=np.asarray(back_sec))
             for gb in backs:
                 fans += _fans(gb, gb.seg >= 0, dom, eps_aim)
     if not fans:

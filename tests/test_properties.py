@@ -170,3 +170,35 @@ def test_translating_within_stationary(seed, theta, k):
         _assert_within(moving, still, sc, f"translating vs stationary at {q}")
     rot = complete_region(sc, target_in="goal", theta=None)
     _assert_within(rot, moving, sc, "rotating vs translating")
+
+
+def test_boxed_in_target_gives_empty_regions():
+    # the target's pocket is exactly its convex hull: no placement can see it
+    ring = [
+        [[1.0, 1.0], [5.0, 1.0], [5.0, 2.0], [1.0, 2.0]],
+        [[1.0, 4.0], [5.0, 4.0], [5.0, 5.0], [1.0, 5.0]],
+        [[1.0, 1.0], [2.0, 1.0], [2.0, 5.0], [1.0, 5.0]],
+        [[4.0, 1.0], [5.0, 1.0], [5.0, 5.0], [4.0, 5.0]],
+    ]
+    d = {
+        "name": "boxed",
+        "bounds": [[0, 0], [12, 0], [12, 8], [0, 8]],
+        "obstacles": ring,
+        "target": [[-1, -1], [1, -1], [1, 1], [-1, 1]],
+        "goal": [[3, 3]],
+        "failure": [[9, 4]],
+    }
+    sc = Scene.from_dict(d)
+    results = [
+        complete_region(sc, target_at=(3.0, 3.0, 0.0)),
+        complete_region(sc, target_in="goal", theta=0.0),
+        complete_region(sc, target_at=(3.0, 3.0, 0.0), eps_pos=0.1),
+        partial_region(sc, target_at=(3.0, 3.0, 0.0)),
+        partial_region(sc, target_at=(3.0, 3.0, 0.0), eps_aim=0.2, eps_pos=0.1),
+        recognizable_region(sc, model="complete"),
+        recognizable_region(sc, model="partial"),
+    ]
+    for r in results:
+        assert r.is_empty and _polygonal(r), r
+    # the same target in the open part of the room is seen from somewhere
+    assert not complete_region(sc, target_at=(9.0, 4.0, 0.0)).is_empty

@@ -426,12 +426,17 @@ def test_regions_agree_with_oracle():
     _check_regions(range(N_SCENES), N_POINTS)
 
 
+def test_eps_regions_agree_with_oracle():
+    _check_eps(range(N_SCENES), N_POINTS, N_EPS_POINTS)
+
+
 @pytest.mark.slow
 @pytest.mark.skipif(not os.environ.get("SENSORPLAN_SLOW"),
                     reason="minutes long: set SENSORPLAN_SLOW=1 (and use -m slow) to run")
 def test_regions_agree_with_oracle_many_scenes():
     seeds = range(N_SCENES, N_SCENES + SLOW_SCENES)
     _check_regions(seeds, SLOW_POINTS)
+    _check_eps(seeds, SLOW_POINTS, 3 * N_EPS_POINTS)
 
 
 if __name__ == "__main__":  # agreement report: python -m tests.test_regions_oracle [--slow]
