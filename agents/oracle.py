@@ -181,20 +181,26 @@ class _Driver:
         self.last_xy = pos
         v = env.max_speed
         move = np.zeros(2)
-        budget = v
-        p = pos.copy()
-        while self.waypoints and budget > 1e-12:
-            d = self.waypoints[0] - p
+        if self.waypoints:
+            # the action square allows sqrt(2) * v along the robot's diagonals: go as far
+            # along the current leg as the square permits (never past its corner)
+            d = self.waypoints[0] - pos
             dist = float(np.hypot(*d))
-            if dist <= budget:
-                move += d
-                p = self.waypoints.pop(0)
-                budget -= dist
-                # stop at corners: the next leg changes direction
-                break
-            move += d * (budget / dist)
-            break
+            rel = math.atan2(d[1], d[0]) - psi
+            reach = v / max(abs(math.cos(rel)), abs(math.sin(rel)), 1e-12)
+            if dist <= reach:
+                move = d
+                self.waypoints.pop(0)
+            else:
+                move = d * (reach / dist)
         aim = self.plan.aim if self.plan is not None and self.plan.status == "ok" else psi
+        left = sum(float(np.hypot(*(b - a))) for a, b in
+                   zip([pos + move, *self.waypoints[:-1]], self.waypoints))
+        if self.waypoints and left > math.sqrt(2) * v:
+            # still travelling: turn so that the next leg runs along a diagonal
+            nxt = self.waypoints[0] - (pos + move)
+            travel = math.atan2(nxt[1], nxt[0])
+            aim = min((travel - math.pi / 4, travel + math.pi / 4), key=lambda a: abs(_wrap(a - psi)))
         c, s = math.cos(psi), math.sin(psi)
         fwd = (c * move[0] + s * move[1]) / v
         lat = (-s * move[0] + c * move[1]) / v
