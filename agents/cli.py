@@ -1,0 +1,118 @@
+"""``sensorplan`` command line: ``train``, ``evaluate`` and ``demo``.
+
+    sensorplan train --env sensorplan/Navigate-v0 --algo ppo --timesteps 150000 --seed 0 --n-envs 2
+    sensorplan evaluate --env sensorplan/Navigate-v0 --policies oracle random \\
+        agents/pretrained/ppo_navigate_lab.zip --episodes 200 --seed 0
+    sensorplan demo            (the paper's surveillance scenario end to end; see agents.demo)
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+
+__all__ = ["build_parser", "main"]
+
+ENV_CHOICES_HELP = "sensorplan/Placement-v0, sensorplan/Navigate-v0 or sensorplan/Recognize-v0"
+
+
+def _json_dict(text: str) -> dict:
+    try:
+        value = json.loads(text)
+    except json.JSONDecodeError as e:
+        raise argparse.ArgumentTypeError(f"not valid JSON: {e}") from None
+    if not isinstance(value, dict):
+        raise argparse.ArgumentTypeError(f"expected a JSON object, got {text!r}")
+    return value
+
+
+def build_parser() -> argparse.ArgumentParser:
+    from .policies import ALGOS
+
+    parser = argparse.ArgumentParser(
+        prog="sensorplan",
+        description="Sensor planning (Briggs & Donald): train and evaluate agents, run the demo.",
+    )
+    sub = parser.add_subparsers(dest="command", metavar="{train,evaluate,demo}")
+    sub.required = True
+
+    t = sub.add_parser("train", help="train a stable-baselines3 baseline",
+                       description="Train an SB3 agent with the YAML hyperparameters in "
+                                   "agents/configs/<algo>.yaml (command-line values override).")
+    t.add_argument("--env", required=True, help=ENV_CHOICES_HELP)
+    t.add_argument("--algo", required=True, choices=ALGOS)
+    t.add_argument("--timesteps", type=int, default=None,
+                   help="total environment steps (default: n_timesteps from the config)")
+    t.add_argument("--seed", type=int, default=0)
+    t.add_argument("--n-envs", type=int, default=None,
+                   help="parallel envs (default: n_envs from the config)")
+    t.add_argument("--env-kwargs", type=_json_dict, default=None,
+                   help='JSON gym.make kwargs merged over the config\'s, e.g. \'{"scene": "lab"}\'')
+    t.add_argument("--config", default=None,
+                   help="hyperparameter YAML (default agents/configs/<algo>.yaml)")
+    t.add_argument("--out", default=None, help="output folder (default runs/<algo>_<env>_s<seed>)")
+    t.add_argument("--eval-freq", type=int, default=None,
+                   help="env steps between periodic evaluations (default: from the config)")
+    t.add_argument("--eval-episodes", type=int, default=None)
+    t.add_argument("--vec-env", choices=("auto", "subproc", "dummy"), default=None,
+                   help="auto: SubprocVecEnv when n_envs > 1 on a multi-core machine "
+                        "(default: the config's vec_env, else auto)")
+    t.add_argument("--threads", type=int, default=1,
+                   help="torch threads (default 1; 0 keeps torch's default)")
+    t.add_argument("--no-progress", action="store_true", help="no progress bar")
+    t.add_argument("--no-tensorboard", action="store_true", help="no TensorBoard logs")
+
+    e = sub.add_parser("evaluate", help="evaluate oracle / random / trained policies",
+                       description="Evaluate policies on the same episode seeds "
+                                   "(1_000_000 + seed onwards) and write a table, JSON, CSV "
+                                   "and a PNG plot.")
+    e.add_argument("--env", required=True, help=ENV_CHOICES_HELP)
+    e.add_argument("--policies", nargs="+", required=True,
+                   help="'oracle', 'random' and/or paths to model zips")
+    e.add_argument("--episodes", type=int, default=100)
+    e.add_argument("--seed", type=int, default=0)
+    e.add_argument("--env-kwargs", type=_json_dict, default=None,
+                   help="JSON gym.make kwargs for the evaluation env")
+    e.add_argument("--out", default=None, help="output folder (default runs/eval_<env>_s<seed>)")
+    e.add_argument("--no-plot", action="store_true")
+
+    sub.add_parser("demo", help="the paper's surveillance scenario end to end (agents.demo)",
+                   add_help=False)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if argv and argv[0] == "demo":
+        from . import demo  # lazily: the demo pulls in plotting and the oracle
+
+        rc = demo.main(argv[1:])
+        return int(rc or 0)
+    args = build_parser().parse_args(argv)
+    try:
+        if args.command == "train":
+            from .train import train
+
+            train(args.env, args.algo, timesteps=args.timesteps, seed=args.seed,
+                  n_envs=args.n_envs, env_kwargs=args.env_kwargs, config=args.config,
+                  out=args.out, eval_freq=args.eval_freq, eval_episodes=args.eval_episodes,
+                  vec_env=args.vec_env, threads=args.threads,
+                  progress_bar=False if args.no_progress else None,
+                  tensorboard=False if args.no_tensorboard else None)
+            return 0
+        if args.command == "evaluate":
+            from .evaluate import evaluate
+
+            evaluate(args.env, args.policies, episodes=args.episodes, seed=args.seed,
+                     env_kwargs=args.env_kwargs, out=args.out, plot=not args.no_plot)
+            return 0
+    except (ValueError, KeyError, FileNotFoundError, NotImplementedError) as err:
+        msg = err.args[0] if isinstance(err, KeyError) and err.args else err
+        print(f"sensorplan {args.command}: error: {msg}", file=sys.stderr)
+        return 2
+    return 1  # pragma: no cover - argparse rejects unknown commands
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,399 @@
+"""Train stable-baselines3 baselines on the sensorplan environments.
+
+``sensorplan train --env ID --algo ALGO --timesteps N --seed S --n-envs K
+[--env-kwargs JSON] [--config FILE] [--out DIR]``
+
+Hyperparameters live in versioned YAML files, one per algorithm, with a section per env id
+(the rl-baselines3-zoo layout): ``agents/configs/<algo>.yaml``.  A section holds the SB3
+constructor arguments plus these keys:
+
+``n_timesteps``, ``n_envs``, ``policy`` (default ``MlpPolicy``), ``env_kwargs`` (passed to
+``gym.make``), ``eval_freq`` (environment steps between evaluations, all envs together),
+``n_eval_episodes``; ``policy_kwargs.activation_fn`` is a name (``tanh``, ``relu``, ...);
+``action_noise: {type: normal|ornstein-uhlenbeck, sigma: s}`` for off-policy algorithms.
+
+Command-line values override the file (``--env-kwargs`` is merged over ``env_kwargs``).
+``--config FILE`` reads another file of the same layout, or a section on its own, or the
+resolved ``*.yaml`` that training writes beside a model (so a run can be repeated exactly).
+
+Outputs in ``--out`` (default ``runs/<algo>_<env>_s<seed>``):
+``best_model.zip`` (best periodic evaluation: highest success rate, then highest mean
+return) and ``best_model.yaml`` (the resolved config: algo, env id, env kwargs,
+hyperparameters, seed, timesteps, versions, wall time), ``final_model.zip`` / ``.yaml``,
+``evaluations.npz`` and, when ``tensorboard`` is installed, TensorBoard logs in ``tb/``.
+
+Seeds: the training envs are seeded ``seed .. seed + n_envs - 1``, the periodic-evaluation
+env ``seed + 10_000``; :mod:`agents.evaluate` uses ``1_000_000 + seed`` onwards, so the
+three never overlap for seeds below 10_000.
+"""
+
+from __future__ import annotations
+
+import copy
+import importlib.util
+import json
+import math
+import multiprocessing
+import os
+import platform
+import shutil
+import sys
+import time
+import warnings
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+
+from .policies import ALGOS, algo_class
+
+__all__ = [
+    "CONFIG_DIR",
+    "EVAL_SEED_OFFSET",
+    "default_out",
+    "load_hyperparams",
+    "package_version",
+    "train",
+]
+
+CONFIG_DIR = Path(__file__).parent / "configs"
+#: offset between the training seed and the periodic-evaluation env's seed
+EVAL_SEED_OFFSET = 10_000
+_META_KEYS = ("n_timesteps", "n_envs", "policy", "env_kwargs", "eval_freq", "n_eval_episodes",
+              "vec_env")
+
+
+def package_version() -> str:
+    """The installed ``sensorplan-gym`` version (read from pyproject.toml in a checkout)."""
+    try:
+        from importlib.metadata import version
+
+        return version("sensorplan-gym")
+    except Exception:  # noqa: BLE001 - not installed: read the checkout's pyproject
+        pyproject = Path(__file__).resolve().parent.parent / "pyproject.toml"
+        try:
+            import tomllib
+
+            with open(pyproject, "rb") as f:
+                return str(tomllib.load(f)["project"]["version"])
+        except Exception:  # noqa: BLE001
+            return "unknown"
+
+
+def _short(env_id: str) -> str:
+    return env_id.split("/")[-1].split("-v")[0].lower()
+
+
+def default_out(algo: str, env_id: str, seed: int) -> Path:
+    return Path("runs") / f"{algo}_{_short(env_id)}_s{seed}"
+
+
+def load_hyperparams(algo: str, env_id: str, config: str | Path | None = None) -> dict:
+    """The hyperparameter section for ``env_id`` from ``config`` (default
+    ``agents/configs/<algo>.yaml``).  A file without that section is taken as one section
+    itself; a resolved run config (with ``hyperparams``) gives its hyperparameters; a
+    ``default`` section serves env ids without their own."""
+    path = Path(config) if config is not None else CONFIG_DIR / f"{algo}.yaml"
+    if not path.is_file():
+        raise FileNotFoundError(f"no hyperparameter file {path}")
+    with open(path) as f:
+        data = yaml.safe_load(f) or {}
+    if not isinstance(data, dict):
+        raise ValueError(f"{path}: expected a mapping, got {type(data).__name__}")
+    if "hyperparams" in data and "env_id" in data:  # a resolved run config
+        if data.get("algo") not in (None, algo):
+            raise ValueError(f"{path} was written for algo {data['algo']!r}, not {algo!r}")
+        section = dict(data["hyperparams"])
+        section.setdefault("env_kwargs", data.get("env_kwargs") or {})
+        section.setdefault("n_envs", data.get("n_envs", 1))
+        section.setdefault("n_timesteps", data.get("timesteps"))
+        return section
+    if env_id in data:
+        return dict(data[env_id] or {})
+    if "default" in data:
+        return dict(data["default"] or {})
+    if config is None:
+        known = ", ".join(k for k in data if "/" in str(k)) or "none"
+        raise KeyError(f"{path} has no section for {env_id!r} (sections: {known}); "
+                       "pass --config FILE with hyperparameters for it")
+    if any("/" in str(k) for k in data):  # a zoo-style file, just not for this env
+        raise KeyError(f"{path} has no section for {env_id!r}")
+    return dict(data)
+
+
+def _activation(name: Any):
+    import torch.nn as nn
+
+    if not isinstance(name, str):
+        return name
+    table = {"tanh": nn.Tanh, "relu": nn.ReLU, "elu": nn.ELU, "leaky_relu": nn.LeakyReLU,
+             "gelu": nn.GELU, "silu": nn.SiLU}
+    try:
+        return table[name.lower().removeprefix("nn.")]
+    except KeyError:
+        raise ValueError(f"unknown activation_fn {name!r}; choose one of {sorted(table)}") from None
+
+
+def _action_noise(spec: Any, action_space):
+    if spec is None:
+        return None
+    from stable_baselines3.common.noise import NormalActionNoise, OrnsteinUhlenbeckActionNoise
+
+    n = int(np.prod(action_space.shape))
+    kind = str(spec.get("type", "normal")).lower()
+    sigma = float(spec.get("sigma", 0.1)) * np.ones(n)
+    if kind == "normal":
+        return NormalActionNoise(np.zeros(n), sigma)
+    if kind in ("ornstein-uhlenbeck", "ou"):
+        return OrnsteinUhlenbeckActionNoise(np.zeros(n), sigma)
+    raise ValueError(f"unknown action_noise type {kind!r} (normal or ornstein-uhlenbeck)")
+
+
+def _subproc_ok() -> bool:
+    return (os.cpu_count() or 1) > 1 and bool(multiprocessing.get_all_start_methods())
+
+
+def _make_env_fn(env_id: str, env_kwargs: dict):
+    def make():
+        import gymnasium as gym
+
+        import sensorplan_gym  # noqa: F401 - registers the ids in subprocesses
+
+        return gym.make(env_id, **env_kwargs)
+
+    return make
+
+
+def check_algo_env(algo: str, env_id: str, env_kwargs: dict) -> None:
+    """Fail early and clearly when the algorithm cannot handle the env's action space."""
+    import gymnasium as gym
+
+    import sensorplan_gym  # noqa: F401
+
+    env = gym.make(env_id, **env_kwargs)
+    try:
+        space = env.action_space
+    finally:
+        env.close()
+    if algo == "dqn" and not isinstance(space, gym.spaces.Discrete):
+        raise ValueError(
+            f"DQN needs a Discrete action space, but {env_id} has {space} (continuous). "
+            "Use ppo, a2c, sac or td3 for this env."
+        )
+    if algo in ("sac", "td3") and not isinstance(space, gym.spaces.Box):
+        raise ValueError(f"{algo.upper()} needs a continuous (Box) action space; "
+                         f"{env_id} has {space}")
+
+
+def _eval_callback_cls():
+    from stable_baselines3.common.callbacks import EvalCallback
+
+    class BestSuccessEvalCallback(EvalCallback):
+        """EvalCallback that keeps the model with the best success rate (ties: mean return)
+        and writes its config beside it."""
+
+        def __init__(self, *args, best_path: Path, write_config, **kwargs) -> None:
+            super().__init__(*args, best_model_save_path=None, **kwargs)
+            self.best_path = best_path
+            self.write_config = write_config
+            self.best_key = (-math.inf, -math.inf)
+            self.best_info: dict | None = None
+
+        def _on_step(self) -> bool:
+            n = len(self.evaluations_results)
+            cont = super()._on_step()
+            if len(self.evaluations_results) > n:
+                sr = float(np.mean(self._is_success_buffer)) if self._is_success_buffer else -1.0
+                key = (sr, float(self.last_mean_reward))
+                if key > self.best_key:
+                    self.best_key = key
+                    self.model.save(self.best_path)
+                    self.best_info = {"timesteps": int(self.num_timesteps), "success_rate": sr,
+                                      "mean_return": float(self.last_mean_reward)}
+                    self.write_config(self.best_path.with_suffix(".yaml"), self.best_info)
+                    if self.verbose:
+                        print(f"new best model: success {sr:.3f}, return "
+                              f"{self.last_mean_reward:.3f} at {self.num_timesteps} steps")
+            return cont
+
+    return BestSuccessEvalCallback
+
+
+def train(
+    env_id: str,
+    algo: str = "ppo",
+    *,
+    timesteps: int | None = None,
+    seed: int = 0,
+    n_envs: int | None = None,
+    env_kwargs: dict | None = None,
+    config: str | Path | None = None,
+    out: str | Path | None = None,
+    eval_freq: int | None = None,
+    eval_episodes: int | None = None,
+    vec_env: str | None = None,
+    threads: int = 1,
+    progress_bar: bool | None = None,
+    tensorboard: bool | None = None,
+    device: str = "cpu",
+    verbose: int = 1,
+) -> dict:
+    """Train ``algo`` on ``env_id``; returns the resolved config with the output paths.
+
+    ``vec_env``: ``"auto"`` (SubprocVecEnv when ``n_envs > 1`` and the machine has more
+    than one core), ``"subproc"`` or ``"dummy"``; ``None`` takes the config's ``vec_env``
+    (default ``"auto"``).  ``threads``: torch intra-op threads (default 1: on a small
+    machine shared with the env workers, more threads make PPO's small-MLP updates
+    many times *slower*).  ``progress_bar`` / ``tensorboard``:
+    ``None`` turns them on when tqdm+rich / tensorboard are importable.
+    """
+    import gymnasium as gym
+    import stable_baselines3
+    import torch
+    from stable_baselines3.common.env_util import make_vec_env
+    from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv
+
+    import sensorplan_gym  # noqa: F401
+
+    algo = algo.lower()
+    if algo not in ALGOS:
+        raise ValueError(f"unknown algorithm {algo!r}; choose one of {', '.join(ALGOS)}")
+    if env_id not in gym.registry:
+        raise ValueError(f"unknown env id {env_id!r}; sensorplan ids: "
+                         f"{', '.join(sensorplan_gym.ENV_IDS)}")
+    hp = load_hyperparams(algo, env_id, config)
+    resolved_env_kwargs = dict(hp.pop("env_kwargs", None) or {})
+    resolved_env_kwargs.update(env_kwargs or {})
+    check_algo_env(algo, env_id, resolved_env_kwargs)
+
+    n_timesteps = int(timesteps if timesteps is not None else hp.pop("n_timesteps", 100_000))
+    hp.pop("n_timesteps", None)
+    n_envs = int(n_envs if n_envs is not None else hp.pop("n_envs", 1))
+    hp.pop("n_envs", None)
+    freq = int(eval_freq if eval_freq is not None else hp.pop("eval_freq", 10_000))
+    hp.pop("eval_freq", None)
+    n_eval = int(eval_episodes if eval_episodes is not None else hp.pop("n_eval_episodes", 10))
+    hp.pop("n_eval_episodes", None)
+    policy = hp.pop("policy", "MlpPolicy")
+    cfg_vec = hp.pop("vec_env", "auto")
+    vec_env = vec_env or cfg_vec
+    if vec_env not in ("auto", "subproc", "dummy"):
+        raise ValueError(f"vec_env must be auto, subproc or dummy, got {vec_env!r}")
+    if n_envs < 1 or n_timesteps < 1:
+        raise ValueError("--n-envs and --timesteps must be positive")
+    hyperparams = copy.deepcopy(hp)  # as written in the YAML, for the record
+
+    out = Path(out) if out is not None else default_out(algo, env_id, seed)
+    if threads:
+        torch.set_num_threads(int(threads))
+    out.mkdir(parents=True, exist_ok=True)
+
+    if vec_env == "auto":
+        vec_env = "subproc" if n_envs > 1 and _subproc_ok() else "dummy"
+    vec_cls = SubprocVecEnv if vec_env == "subproc" else DummyVecEnv
+    make = _make_env_fn(env_id, resolved_env_kwargs)
+    venv = make_vec_env(make, n_envs=n_envs, seed=seed, vec_env_cls=vec_cls)
+    eval_env = make_vec_env(make, n_envs=1, seed=seed + EVAL_SEED_OFFSET, vec_env_cls=DummyVecEnv)
+
+    kwargs = dict(hp)
+    pk = dict(kwargs.pop("policy_kwargs", None) or {})
+    if "activation_fn" in pk:
+        pk["activation_fn"] = _activation(pk["activation_fn"])
+    if pk:
+        kwargs["policy_kwargs"] = pk
+    if "action_noise" in kwargs:
+        kwargs["action_noise"] = _action_noise(kwargs["action_noise"], venv.action_space)
+    if tensorboard is None:
+        tensorboard = importlib.util.find_spec("tensorboard") is not None
+    if tensorboard:
+        kwargs["tensorboard_log"] = str(out / "tb")
+    if progress_bar is None:
+        progress_bar = all(importlib.util.find_spec(m) is not None for m in ("tqdm", "rich"))
+
+    record: dict[str, Any] = {
+        "algo": algo,
+        "env_id": env_id,
+        "env_kwargs": resolved_env_kwargs,
+        "policy": policy,
+        "hyperparams": hyperparams,
+        "seed": int(seed),
+        "timesteps": n_timesteps,
+        "n_envs": n_envs,
+        "vec_env": vec_env,
+        "torch_threads": int(threads or torch.get_num_threads()),
+        "eval": {"freq": freq, "episodes": n_eval, "seed": seed + EVAL_SEED_OFFSET},
+        "versions": {
+            "sensorplan-gym": package_version(),
+            "stable-baselines3": str(stable_baselines3.__version__),
+            "torch": str(torch.__version__),
+            "gymnasium": str(gym.__version__),
+            "python": platform.python_version(),
+        },
+        "command": " ".join(["sensorplan", "train", "--env", env_id, "--algo", algo,
+                             "--timesteps", str(n_timesteps), "--seed", str(seed),
+                             "--n-envs", str(n_envs)]
+                            + (["--env-kwargs", json.dumps(env_kwargs)] if env_kwargs else [])
+                            + (["--config", str(config)] if config else [])),
+    }
+    t0 = time.perf_counter()
+
+    def write_config(path: Path, extra: dict | None = None) -> None:
+        rec = dict(record)
+        rec["wall_time_s"] = round(time.perf_counter() - t0, 1)
+        if extra:
+            rec["selected_at"] = extra
+        with open(path, "w") as f:
+            stamp = time.strftime("%Y-%m-%d")
+            f.write(f"# resolved config written by sensorplan train ({stamp})\n")
+            yaml.safe_dump(rec, f, sort_keys=False)
+
+    model = algo_class(algo)(policy, venv, seed=seed, verbose=0 if verbose < 2 else 1,
+                             device=device, **kwargs)
+    callback = _eval_callback_cls()(
+        eval_env,
+        best_path=out / "best_model.zip",
+        write_config=write_config,
+        n_eval_episodes=n_eval,
+        eval_freq=max(freq // n_envs, 1),
+        log_path=str(out),
+        deterministic=True,
+        verbose=verbose,
+    )
+    if verbose:
+        print(f"training {algo.upper()} on {env_id} {resolved_env_kwargs} for {n_timesteps} steps, "
+              f"seed {seed}, {n_envs} x {vec_cls.__name__} -> {out}", flush=True)
+    try:
+        warnings.filterwarnings("ignore", message="Training and eval env are not of the same type")
+        model.learn(total_timesteps=n_timesteps, callback=callback, progress_bar=progress_bar,
+                    tb_log_name=f"{algo}_s{seed}")
+    finally:
+        venv.close()
+    train_time = time.perf_counter() - t0
+    record["train_time_s"] = round(train_time, 1)
+    model.save(out / "final_model.zip")
+    write_config(out / "final_model.yaml")
+    if callback.best_info is None:  # no evaluation ran (short run): the final model is the best
+        shutil.copyfile(out / "final_model.zip", out / "best_model.zip")
+        write_config(out / "best_model.yaml", {"timesteps": int(model.num_timesteps),
+                                               "success_rate": None, "mean_return": None})
+    else:
+        # rewrite so the best model's config carries the total training time too
+        write_config(out / "best_model.yaml", callback.best_info)
+    eval_env.close()
+    record.update({
+        "out": str(out),
+        "best_model": str(out / "best_model.zip"),
+        "final_model": str(out / "final_model.zip"),
+        "best": callback.best_info,
+    })
+    if verbose:
+        print(f"done in {train_time:.1f} s; best model {out / 'best_model.zip'} "
+              f"{callback.best_info or ''}", flush=True)
+    return record
+
+
+if __name__ == "__main__":  # pragma: no cover
+    from .cli import main
+
+    sys.exit(main(["train", *sys.argv[1:]]))
