@@ -293,7 +293,8 @@ def evaluate(
         if plot:
             _plot(results, Path(files["png"]))
     if verbose:
-        print(f"\n{env_id} {env_kwargs or ''}: {episodes} episodes, seeds "
+        print(f"\n{env_id}{' ' + json.dumps(env_kwargs) if env_kwargs else ''}: {episodes} "
+              f"episodes, seeds "
               f"{seeds[0]}..{seeds[-1]}")
         print(format_table(results))
         if results["files"]:
