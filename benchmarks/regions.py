@@ -30,7 +30,7 @@ import shapely
 from geometry import Scene, complete_region, partial_region, recognizable_region
 from geometry.generate import scene_with_edges
 
-EDGES = (25, 50, 100, 200)
+EDGES = (25, 50, 100, 160, 200)
 SEED = 1
 RESULTS = Path(__file__).resolve().parent / "results" / "regions.md"
 

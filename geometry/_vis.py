@@ -306,21 +306,26 @@ def gaps_many(
 
 def _first_hits(dom: Domain, q: np.ndarray, phi: np.ndarray) -> np.ndarray:
     """Index of the first segment hit by rays from ``q`` (one point or one per
-    ray) at angles ``phi``."""
+    ray) at angles ``phi``.
+
+    With ray ``q + t d`` and segment ``a + s e``: ``den = d x e``,
+    ``t = ((a - q) x e) / den``, ``s = ((a - q) x d) / den``; each numerator is a
+    small matrix product over (rays x 3) and (3 x segments).
+    """
     q = np.broadcast_to(q, (len(phi), 2))
-    dx = np.cos(phi)[:, None]
-    dy = np.sin(phi)[:, None]
-    ax = dom.seg[None, :, 0] - q[:, 0:1]
-    ay = dom.seg[None, :, 1] - q[:, 1:2]
-    ex = (dom.seg[:, 2] - dom.seg[:, 0])[None, :]
-    ey = (dom.seg[:, 3] - dom.seg[:, 1])[None, :]
-    den = dx * ey - dy * ex
+    dx, dy = np.cos(phi), np.sin(phi)
+    x0, y0 = dom.seg[:, 0], dom.seg[:, 1]
+    ex, ey = dom.seg[:, 2] - x0, dom.seg[:, 3] - y0
+    ones = np.ones_like(dx)
+    den = np.stack([dx, dy], axis=1) @ np.stack([ey, -ex])
+    t_num = np.stack([ones, -q[:, 0], q[:, 1]], axis=1) @ np.stack([x0 * ey - y0 * ex, ey, ex])
+    s_num = np.stack([dy, -dx, q[:, 1] * dx - q[:, 0] * dy], axis=1) @ np.stack([x0, y0, np.ones_like(x0)])
     with np.errstate(divide="ignore", invalid="ignore"):
-        t = (ax * ey - ay * ex) / den
-        s = (ax * dy - ay * dx) / den
+        inv = 1.0 / den
+        t = t_num * inv
+        s_ = s_num * inv
     tmin = 1e-11 * dom.scale
-    valid = (t > tmin) & (s >= -1e-12) & (s <= 1.0 + 1e-12)
-    t = np.where(valid, t, np.inf)
+    t[~((t > tmin) & (s_ >= -1e-12) & (s_ <= 1.0 + 1e-12))] = np.inf
     j = np.argmin(t, axis=1)
     if not np.all(np.isfinite(t[np.arange(len(j)), j])):
         raise RuntimeError("visibility ray escaped the domain: the boundary is not closed")
