@@ -37,48 +37,79 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", metavar="{train,evaluate,demo}")
     sub.required = True
 
-    t = sub.add_parser("train", help="train a stable-baselines3 baseline",
-                       description="Train an SB3 agent with the YAML hyperparameters in "
-                                   "agents/configs/<algo>.yaml (command-line values override).")
+    t = sub.add_parser(
+        "train",
+        help="train a stable-baselines3 baseline",
+        description="Train an SB3 agent with the YAML hyperparameters in "
+        "agents/configs/<algo>.yaml (command-line values override).",
+    )
     t.add_argument("--env", required=True, help=ENV_CHOICES_HELP)
     t.add_argument("--algo", required=True, choices=ALGOS)
-    t.add_argument("--timesteps", type=int, default=None,
-                   help="total environment steps (default: n_timesteps from the config)")
+    t.add_argument(
+        "--timesteps",
+        type=int,
+        default=None,
+        help="total environment steps (default: n_timesteps from the config)",
+    )
     t.add_argument("--seed", type=int, default=0)
-    t.add_argument("--n-envs", type=int, default=None,
-                   help="parallel envs (default: n_envs from the config)")
-    t.add_argument("--env-kwargs", type=_json_dict, default=None,
-                   help='JSON gym.make kwargs merged over the config\'s, e.g. \'{"scene": "lab"}\'')
-    t.add_argument("--config", default=None,
-                   help="hyperparameter YAML (default agents/configs/<algo>.yaml)")
+    t.add_argument(
+        "--n-envs", type=int, default=None, help="parallel envs (default: n_envs from the config)"
+    )
+    t.add_argument(
+        "--env-kwargs",
+        type=_json_dict,
+        default=None,
+        help='JSON gym.make kwargs merged over the config\'s, e.g. \'{"scene": "lab"}\'',
+    )
+    t.add_argument(
+        "--config", default=None, help="hyperparameter YAML (default agents/configs/<algo>.yaml)"
+    )
     t.add_argument("--out", default=None, help="output folder (default runs/<algo>_<env>_s<seed>)")
-    t.add_argument("--eval-freq", type=int, default=None,
-                   help="env steps between periodic evaluations (default: from the config)")
+    t.add_argument(
+        "--eval-freq",
+        type=int,
+        default=None,
+        help="env steps between periodic evaluations (default: from the config)",
+    )
     t.add_argument("--eval-episodes", type=int, default=None)
-    t.add_argument("--vec-env", choices=("auto", "subproc", "dummy"), default=None,
-                   help="auto: SubprocVecEnv when n_envs > 1 on a multi-core machine "
-                        "(default: the config's vec_env, else auto)")
-    t.add_argument("--threads", type=int, default=1,
-                   help="torch threads (default 1; 0 keeps torch's default)")
+    t.add_argument(
+        "--vec-env",
+        choices=("auto", "subproc", "dummy"),
+        default=None,
+        help="auto: SubprocVecEnv when n_envs > 1 on a multi-core machine "
+        "(default: the config's vec_env, else auto)",
+    )
+    t.add_argument(
+        "--threads", type=int, default=1, help="torch threads (default 1; 0 keeps torch's default)"
+    )
     t.add_argument("--no-progress", action="store_true", help="no progress bar")
     t.add_argument("--no-tensorboard", action="store_true", help="no TensorBoard logs")
 
-    e = sub.add_parser("evaluate", help="evaluate oracle / random / trained policies",
-                       description="Evaluate policies on the same episode seeds "
-                                   "(1_000_000 + seed onwards) and write a table, JSON, CSV "
-                                   "and a PNG plot.")
+    e = sub.add_parser(
+        "evaluate",
+        help="evaluate oracle / random / trained policies",
+        description="Evaluate policies on the same episode seeds "
+        "(1_000_000 + seed onwards) and write a table, JSON, CSV "
+        "and a PNG plot.",
+    )
     e.add_argument("--env", required=True, help=ENV_CHOICES_HELP)
-    e.add_argument("--policies", nargs="+", required=True,
-                   help="'oracle', 'random' and/or paths to model zips")
+    e.add_argument(
+        "--policies", nargs="+", required=True, help="'oracle', 'random' and/or paths to model zips"
+    )
     e.add_argument("--episodes", type=int, default=100)
     e.add_argument("--seed", type=int, default=0)
-    e.add_argument("--env-kwargs", type=_json_dict, default=None,
-                   help="JSON gym.make kwargs for the evaluation env")
+    e.add_argument(
+        "--env-kwargs",
+        type=_json_dict,
+        default=None,
+        help="JSON gym.make kwargs for the evaluation env",
+    )
     e.add_argument("--out", default=None, help="output folder (default runs/eval_<env>_s<seed>)")
     e.add_argument("--no-plot", action="store_true")
 
-    sub.add_parser("demo", help="the paper's surveillance scenario end to end (agents.demo)",
-                   add_help=False)
+    sub.add_parser(
+        "demo", help="the paper's surveillance scenario end to end (agents.demo)", add_help=False
+    )
     return parser
 
 
@@ -94,18 +125,35 @@ def main(argv: list[str] | None = None) -> int:
         if args.command == "train":
             from .train import train
 
-            train(args.env, args.algo, timesteps=args.timesteps, seed=args.seed,
-                  n_envs=args.n_envs, env_kwargs=args.env_kwargs, config=args.config,
-                  out=args.out, eval_freq=args.eval_freq, eval_episodes=args.eval_episodes,
-                  vec_env=args.vec_env, threads=args.threads,
-                  progress_bar=False if args.no_progress else None,
-                  tensorboard=False if args.no_tensorboard else None)
+            train(
+                args.env,
+                args.algo,
+                timesteps=args.timesteps,
+                seed=args.seed,
+                n_envs=args.n_envs,
+                env_kwargs=args.env_kwargs,
+                config=args.config,
+                out=args.out,
+                eval_freq=args.eval_freq,
+                eval_episodes=args.eval_episodes,
+                vec_env=args.vec_env,
+                threads=args.threads,
+                progress_bar=False if args.no_progress else None,
+                tensorboard=False if args.no_tensorboard else None,
+            )
             return 0
         if args.command == "evaluate":
             from .evaluate import evaluate
 
-            evaluate(args.env, args.policies, episodes=args.episodes, seed=args.seed,
-                     env_kwargs=args.env_kwargs, out=args.out, plot=not args.no_plot)
+            evaluate(
+                args.env,
+                args.policies,
+                episodes=args.episodes,
+                seed=args.seed,
+                env_kwargs=args.env_kwargs,
+                out=args.out,
+                plot=not args.no_plot,
+            )
             return 0
     except (ValueError, KeyError, FileNotFoundError, NotImplementedError) as err:
         msg = err.args[0] if isinstance(err, KeyError) and err.args else err

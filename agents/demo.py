@@ -58,8 +58,16 @@ def _figure_16(scene, world, plan, start, path: Path) -> None:
         p = np.asarray(plan.path)
         motion = "one-step motion" if plan.one_step else "shortest path"
         ax.plot(p[:, 0], p[:, 1], "-", color="#ff7f0e", lw=2, label=motion)
-        draw_pose(ax, plan.point[0], plan.point[1], plan.aim, fov=world.fov,
-                  length=0.06 * world.diameter, color="#ff7f0e", label="chosen placement")
+        draw_pose(
+            ax,
+            plan.point[0],
+            plan.point[1],
+            plan.aim,
+            fov=world.fov,
+            length=0.06 * world.diameter,
+            color="#ff7f0e",
+            label="chosen placement",
+        )
     ax.set_title("Figure 16: shrunk region, chosen placement and motion")
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
     fig.savefig(path, dpi=120, bbox_inches="tight")
@@ -98,8 +106,12 @@ def main(argv: list[str] | None = None) -> int:
     """Run the demo; returns a process exit code."""
     ap = argparse.ArgumentParser(prog="sensorplan demo", description=__doc__.split("\n\n")[0])
     ap.add_argument("--out", default="sensorplan-demo", help="folder for figures and results")
-    ap.add_argument("--episodes", type=int, default=50,
-                    help="evaluation episodes per policy (default 50; README uses 200)")
+    ap.add_argument(
+        "--episodes",
+        type=int,
+        default=50,
+        help="evaluation episodes per policy (default 50; README uses 200)",
+    )
     ap.add_argument("--seed", type=int, default=0)
     args = ap.parse_args(argv)
     import matplotlib
@@ -118,28 +130,36 @@ def main(argv: list[str] | None = None) -> int:
     print(f"1. Scene 'lab': {len(scene.obstacles)} furniture footprints, doorway G, watch spot H")
     t = time.perf_counter()
     vis = complete_region(scene, target_in="goal", theta=0.0)
-    print(f"   complete-visibility region of the doorway: area {vis.area:.2f} m^2, "
-          f"computed exactly in {1e3 * (time.perf_counter() - t):.1f} ms")
+    print(
+        f"   complete-visibility region of the doorway: area {vis.area:.2f} m^2, "
+        f"computed exactly in {1e3 * (time.perf_counter() - t):.1f} ms"
+    )
     _figure_15(scene, vis, out / "fig15_visibility.png")
 
     world = World(scene, WorldConfig())
     start = scene.start
     plan = plan_viewpoint(world, start[:2])
-    print(f"2. Recognizable region R(G) n R(H) - C(G,H): area {world.region.area:.2f} m^2; "
-          f"start {tuple(round(v, 2) for v in start[:2])} recognizes: "
-          f"{world.recognizing(*start)}")
+    print(
+        f"2. Recognizable region R(G) n R(H) - C(G,H): area {world.region.area:.2f} m^2; "
+        f"start {tuple(round(v, 2) for v in start[:2])} recognizes: "
+        f"{world.recognizing(*start)}"
+    )
     if plan.status != "ok":
         print(f"   no placement: {plan.reason}")
         return 1
     kind = "one-step motion" if plan.one_step else f"shortest path with {len(plan.path) - 1} legs"
-    print(f"   chosen placement ({plan.point[0]:.2f}, {plan.point[1]:.2f}), aim "
-          f"{math.degrees(plan.aim):.1f} deg, {kind} of {plan.length:.2f} m")
+    print(
+        f"   chosen placement ({plan.point[0]:.2f}, {plan.point[1]:.2f}), aim "
+        f"{math.degrees(plan.aim):.1f} deg, {kind} of {plan.length:.2f} m"
+    )
     _figure_16(scene, world, plan, start, out / "fig16_placement.png")
 
     truth, declared, steps = _recognize(out, args.seed)
     verdict = "correct" if truth == declared else "WRONG"
-    print(f"3. Oracle drove there and declared '{declared}' after {steps} steps; the target was "
-          f"in '{truth}' ({verdict})")
+    print(
+        f"3. Oracle drove there and declared '{declared}' after {steps} steps; the target was "
+        f"in '{truth}' ({verdict})"
+    )
 
     print(f"4. Navigate-v0 (lab), {args.episodes} episodes per policy:")
     from .evaluate import evaluate, format_table
@@ -149,8 +169,15 @@ def main(argv: list[str] | None = None) -> int:
         policies.append(str(PRETRAINED))
     else:
         print(f"   (no shipped policy at {PRETRAINED}; evaluating oracle and random only)")
-    res = evaluate("sensorplan/Navigate-v0", policies, episodes=args.episodes, seed=args.seed,
-                   env_kwargs={"scene": "lab"}, out=out / "navigate_eval", verbose=False)
+    res = evaluate(
+        "sensorplan/Navigate-v0",
+        policies,
+        episodes=args.episodes,
+        seed=args.seed,
+        env_kwargs={"scene": "lab"},
+        out=out / "navigate_eval",
+        verbose=False,
+    )
     print(format_table(res))
     print(f"Figures and results in {out.resolve()} ({time.perf_counter() - t0:.1f} s)")
     return 0 if truth == declared else 1

@@ -63,8 +63,9 @@ def run_episodes(env, policy, seeds: list[int], *, deterministic: bool = True) -
         ret, steps, path = 0.0, 0, 0.0
         done = False
         while not done:
-            action, state = policy.predict(obs, state=state, episode_start=start,
-                                           deterministic=deterministic)
+            action, state = policy.predict(
+                obs, state=state, episode_start=start, deterministic=deterministic
+            )
             start = np.zeros(1, dtype=bool)
             obs, reward, terminated, truncated, info = env.step(action)
             ret += float(reward)
@@ -117,19 +118,35 @@ def format_table(results: dict) -> str:
     rows = []
     for p in results["policies"]:
         lo, hi = p["success_ci95"]
-        rows.append([p["name"], _fmt(p["success_rate"]), f"[{lo:.3f}, {hi:.3f}]",
-                     _fmt(p["mean_return"]), _fmt(p["mean_steps"], 1),
-                     _fmt(p["mean_path_length"], 2), _fmt(p["normalized_score"])])
+        rows.append(
+            [
+                p["name"],
+                _fmt(p["success_rate"]),
+                f"[{lo:.3f}, {hi:.3f}]",
+                _fmt(p["mean_return"]),
+                _fmt(p["mean_steps"], 1),
+                _fmt(p["mean_path_length"], 2),
+                _fmt(p["normalized_score"]),
+            ]
+        )
     widths = [max(len(h), *(len(r[i]) for r in rows)) for i, h in enumerate(head)]
-    line = "  ".join(h.ljust(w) if i == 0 else h.rjust(w)
-                     for i, (h, w) in enumerate(zip(head, widths, strict=True)))
+    line = "  ".join(
+        h.ljust(w) if i == 0 else h.rjust(w)
+        for i, (h, w) in enumerate(zip(head, widths, strict=True))
+    )
     out = [line, "-" * len(line)]
     for r in rows:
-        out.append("  ".join(c.ljust(w) if i == 0 else c.rjust(w)
-                             for i, (c, w) in enumerate(zip(r, widths, strict=True))))
+        out.append(
+            "  ".join(
+                c.ljust(w) if i == 0 else c.rjust(w)
+                for i, (c, w) in enumerate(zip(r, widths, strict=True))
+            )
+        )
     for algo, a in (results.get("iqm") or {}).items():
-        out.append(f"{algo}: IQM success over {a['n_runs']} training seeds = {a['iqm']:.3f} "
-                   f"[{a['ci95'][0]:.3f}, {a['ci95'][1]:.3f}] (stratified bootstrap)")
+        out.append(
+            f"{algo}: IQM success over {a['n_runs']} training seeds = {a['iqm']:.3f} "
+            f"[{a['ci95'][0]:.3f}, {a['ci95'][1]:.3f}] (stratified bootstrap)"
+        )
     return "\n".join(out)
 
 
@@ -151,17 +168,26 @@ def _plot(results: dict, path: Path) -> None:
     axes[0].errorbar(x, sr, yerr=yerr, fmt="none", ecolor="k", capsize=4)
     axes[0].set_ylim(0, 1.05)
     axes[0].set_title("success rate (95% Wilson CI)")
-    axes[1].bar(x, [p["mean_return"] for p in pols],
-                yerr=[p["std_return"] for p in pols], color="tab:green", alpha=0.8, capsize=4)
+    axes[1].bar(
+        x,
+        [p["mean_return"] for p in pols],
+        yerr=[p["std_return"] for p in pols],
+        color="tab:green",
+        alpha=0.8,
+        capsize=4,
+    )
     axes[1].set_title("return (mean +- std)")
     axes[2].bar(x, [p["mean_steps"] for p in pols], color="tab:orange", alpha=0.8)
     axes[2].set_title("steps per episode (mean)")
     for ax in axes:
         ax.set_xticks(x)
         ax.set_xticklabels(names, rotation=20, ha="right", fontsize=8)
-    fig.suptitle(f"{results['env_id']} {results['env_kwargs'] or ''}: "
-                 f"{results['episodes']} episodes, seeds {results['episode_seeds'][0]}.."
-                 f"{results['episode_seeds'][1]}", fontsize=9)
+    fig.suptitle(
+        f"{results['env_id']} {results['env_kwargs'] or ''}: "
+        f"{results['episodes']} episodes, seeds {results['episode_seeds'][0]}.."
+        f"{results['episode_seeds'][1]}",
+        fontsize=9,
+    )
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
@@ -200,8 +226,9 @@ def evaluate(
     if not policies:
         raise ValueError("no policies to evaluate")
     if env_id not in gym.registry:
-        raise ValueError(f"unknown env id {env_id!r}; sensorplan ids: "
-                         f"{', '.join(sensorplan_gym.ENV_IDS)}")
+        raise ValueError(
+            f"unknown env id {env_id!r}; sensorplan ids: {', '.join(sensorplan_gym.ENV_IDS)}"
+        )
     if threads:
         try:
             import torch
@@ -229,15 +256,23 @@ def evaluate(
             meta: dict[str, Any] = {"kind": spec if spec in ("oracle", "random") else "model"}
             if meta["kind"] == "model":
                 cfg = model_config(spec) or {}
-                meta.update({"algo": cfg.get("algo") or type(policy).__name__.lower(),
-                             "train_seed": cfg.get("seed"),
-                             "train_env_kwargs": cfg.get("env_kwargs")})
+                meta.update(
+                    {
+                        "algo": cfg.get("algo") or type(policy).__name__.lower(),
+                        "train_seed": cfg.get("seed"),
+                        "train_env_kwargs": cfg.get("env_kwargs"),
+                    }
+                )
                 if cfg.get("env_id") not in (None, env_id):
                     print(f"warning: {spec} was trained on {cfg['env_id']}, evaluated on {env_id}")
-                tk = {k: v for k, v in (cfg.get("env_kwargs") or {}).items()
-                      if k not in _REWARD_ONLY}
-                diff = {k: (v, env_kwargs.get(k)) for k, v in tk.items()
-                        if env_kwargs.get(k, "lab" if k == "scene" else None) != v}
+                tk = {
+                    k: v for k, v in (cfg.get("env_kwargs") or {}).items() if k not in _REWARD_ONLY
+                }
+                diff = {
+                    k: (v, env_kwargs.get(k))
+                    for k, v in tk.items()
+                    if env_kwargs.get(k, "lab" if k == "scene" else None) != v
+                }
                 if diff and verbose:
                     print(f"note: {name} was trained with env kwargs {diff} (trained, evaluated)")
             t0 = time.perf_counter()
@@ -248,14 +283,17 @@ def evaluate(
         results["policies"].append(_summary(name, spec, ep, meta))
         if verbose:
             s = results["policies"][-1]
-            print(f"  {name}: success {s['success_rate']:.3f} in {meta['eval_time_s']:.1f} s",
-                  flush=True)
+            print(
+                f"  {name}: success {s['success_rate']:.3f} in {meta['eval_time_s']:.1f} s",
+                flush=True,
+            )
 
     by = {p["kind"]: p for p in results["policies"] if p["kind"] in ("oracle", "random")}
     if "oracle" in by and "random" in by:
         for p in results["policies"]:
-            v = normalized_score(p["success_rate"], by["random"]["success_rate"],
-                                 by["oracle"]["success_rate"])
+            v = normalized_score(
+                p["success_rate"], by["random"]["success_rate"], by["oracle"]["success_rate"]
+            )
             p["normalized_score"] = None if math.isnan(v) else v
 
     groups: dict[str, list[dict]] = defaultdict(list)
@@ -267,13 +305,20 @@ def evaluate(
         if len(runs) >= 2 and len(train_seeds) == len(runs):
             scores = np.array([[r["success_rate"]] for r in runs])  # (runs, tasks=1)
             est, lo, hi = stratified_bootstrap_ci(scores, iqm, seed=seed)
-            results["iqm"][algo] = {"n_runs": len(runs), "train_seeds": sorted(
-                train_seeds, key=lambda s: (s is None, s)), "iqm": est, "ci95": [lo, hi],
-                "policies": [r["name"] for r in runs]}
+            results["iqm"][algo] = {
+                "n_runs": len(runs),
+                "train_seeds": sorted(train_seeds, key=lambda s: (s is None, s)),
+                "iqm": est,
+                "ci95": [lo, hi],
+                "policies": [r["name"] for r in runs],
+            }
 
     if out is not False:
-        outdir = Path(out) if out is not None else \
-            Path("runs") / f"eval_{env_id.split('/')[-1].split('-v')[0].lower()}_s{seed}"
+        outdir = (
+            Path(out)
+            if out is not None
+            else Path("runs") / f"eval_{env_id.split('/')[-1].split('-v')[0].lower()}_s{seed}"
+        )
         outdir.mkdir(parents=True, exist_ok=True)
         files = {"json": str(outdir / "results.json"), "csv": str(outdir / "results.csv")}
         if plot:
@@ -281,9 +326,21 @@ def evaluate(
         results["files"] = files
         with open(files["json"], "w") as f:
             json.dump(results, f, indent=1)
-        cols = ["name", "spec", "kind", "episodes", "successes", "success_rate", "ci95_low",
-                "ci95_high", "mean_return", "std_return", "mean_steps", "mean_path_length",
-                "normalized_score"]
+        cols = [
+            "name",
+            "spec",
+            "kind",
+            "episodes",
+            "successes",
+            "success_rate",
+            "ci95_low",
+            "ci95_high",
+            "mean_return",
+            "std_return",
+            "mean_steps",
+            "mean_path_length",
+            "normalized_score",
+        ]
         with open(files["csv"], "w", newline="") as f:
             w = csv.writer(f)
             w.writerow(cols)
@@ -293,9 +350,11 @@ def evaluate(
         if plot:
             _plot(results, Path(files["png"]))
     if verbose:
-        print(f"\n{env_id}{' ' + json.dumps(env_kwargs) if env_kwargs else ''}: {episodes} "
-              f"episodes, seeds "
-              f"{seeds[0]}..{seeds[-1]}")
+        print(
+            f"\n{env_id}{' ' + json.dumps(env_kwargs) if env_kwargs else ''}: {episodes} "
+            f"episodes, seeds "
+            f"{seeds[0]}..{seeds[-1]}"
+        )
         print(format_table(results))
         if results["files"]:
             print("wrote " + ", ".join(results["files"].values()))

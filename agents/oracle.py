@@ -78,18 +78,20 @@ def _aim_feasible_region(world, region: shapely.Geometry, n: int = 24) -> shapel
     gx, gy = np.meshgrid(xs, ys, indexing="ij")
     ok = np.zeros_like(gx, dtype=bool)
     inside = shapely.contains_xy(region, gx, gy)
-    for i, j in zip(*np.nonzero(inside)):
+    for i, j in zip(*np.nonzero(inside), strict=False):
         x, y = gx[i, j], gy[i, j]
         ok[i, j] = world.aim_ok(x, y, _aim_for(world, np.array([x, y]))[0])
     good = ok[:-1, :-1] & ok[1:, :-1] & ok[:-1, 1:] & ok[1:, 1:]
-    cells = [shapely.box(xs[i], ys[j], xs[i + 1], ys[j + 1]) for i, j in zip(*np.nonzero(good))]
-    if not cells:
+    gi, gj = np.nonzero(good)
+    if len(gi) == 0:
         return shapely.Polygon()
+    cells = shapely.box(xs[gi], ys[gj], xs[gi + 1], ys[gj + 1])
     return shapely.intersection(region, shapely.union_all(cells))
 
 
-def plan_viewpoint(world, start_xy: Any, *, keep_out: shapely.Geometry | None = None,
-                   margin: float | None = None) -> ViewpointPlan:
+def plan_viewpoint(
+    world, start_xy: Any, *, keep_out: shapely.Geometry | None = None, margin: float | None = None
+) -> ViewpointPlan:
     """Choose a recognizing pose reachable from ``start_xy`` (paper 6.2-6.3).
 
     ``world`` is an environment's :class:`sensorplan_gym.core.world.World`;
@@ -114,21 +116,26 @@ def plan_viewpoint(world, start_xy: Any, *, keep_out: shapely.Geometry | None = 
     clearance = max(rr, min(rr + 1e-4 * world.diameter, rr + 0.25 * (room - rr)))
 
     def attempt(reg: shapely.Geometry) -> ViewpointPlan:
-        pl = choose_placement(world.scene, reg, start, robot_radius=clearance, margin=margin,
-                              keep_out=keep_out)
+        pl = choose_placement(
+            world.scene, reg, start, robot_radius=clearance, margin=margin, keep_out=keep_out
+        )
         if pl.status != "ok":
             return ViewpointPlan(pl.status, reason=pl.reason, placement=pl)
         psi, _ = _aim_for(world, pl.point)
-        return ViewpointPlan("ok", np.asarray(pl.point), psi, pl.path.points, pl.length,
-                             pl.one_step, pl.reason, pl)
+        return ViewpointPlan(
+            "ok", np.asarray(pl.point), psi, pl.path.points, pl.length, pl.one_step, pl.reason, pl
+        )
 
     plan = attempt(region)
     if plan.status == "ok" and world.aim_ok(*plan.point, plan.aim):
         return plan
     feasible = _aim_feasible_region(world, region)
     if feasible.is_empty:
-        return ViewpointPlan("no_placement", reason="no placement of the recognizable region "
-                             "keeps both swept targets in the field of view and range")
+        return ViewpointPlan(
+            "no_placement",
+            reason="no placement of the recognizable region "
+            "keeps both swept targets in the field of view and range",
+        )
     plan = attempt(feasible)
     if plan.status == "ok" and not world.aim_ok(*plan.point, plan.aim):
         plan.status, plan.reason = "no_placement", "the chosen point fails the aim check"
@@ -161,7 +168,9 @@ class _Driver:
         x, y, _ = self.env.pose
         keep_out = None
         if self.env.spec_kind == "recognize":
-            keep_out = shapely.union(*(shapely.convex_hull(shapely.multipoints(k)) for k in w.must_see))
+            keep_out = shapely.union(
+                *(shapely.convex_hull(shapely.multipoints(k)) for k in w.must_see)
+            )
         self.plan = plan_viewpoint(w, (x, y), keep_out=keep_out)
         self.waypoints = [] if self.plan.status != "ok" else [p for p in self.plan.path[1:]]
 
@@ -173,7 +182,11 @@ class _Driver:
         pos = np.array([x, y])
         if self.plan is None:
             self._replan()
-        if self.last_xy is not None and self.waypoints and np.allclose(pos, self.last_xy, atol=1e-12):
+        if (
+            self.last_xy is not None
+            and self.waypoints
+            and np.allclose(pos, self.last_xy, atol=1e-12)
+        ):
             self.stuck += 1
             if self.stuck >= 3:
                 self._replan()
@@ -194,13 +207,17 @@ class _Driver:
             else:
                 move = d * (reach / dist)
         aim = self.plan.aim if self.plan is not None and self.plan.status == "ok" else psi
-        left = sum(float(np.hypot(*(b - a))) for a, b in
-                   zip([pos + move, *self.waypoints[:-1]], self.waypoints))
+        left = sum(
+            float(np.hypot(*(b - a)))
+            for a, b in zip([pos + move, *self.waypoints[:-1]], self.waypoints, strict=False)
+        )
         if self.waypoints and left > math.sqrt(2) * v:
             # still travelling: turn so that the next leg runs along a diagonal
             nxt = self.waypoints[0] - (pos + move)
             travel = math.atan2(nxt[1], nxt[0])
-            aim = min((travel - math.pi / 4, travel + math.pi / 4), key=lambda a: abs(_wrap(a - psi)))
+            aim = min(
+                (travel - math.pi / 4, travel + math.pi / 4), key=lambda a: abs(_wrap(a - psi))
+            )
         c, s = math.cos(psi), math.sin(psi)
         fwd = (c * move[0] + s * move[1]) / v
         lat = (-s * move[0] + c * move[1]) / v
@@ -244,8 +261,16 @@ class _Driver:
         else:
             tau = max(0.05 * w.target_radius, 2.5 * tol)
             res = None
-        dec = classify(pts, np.ones(len(pts), dtype=bool), w.scene, goal=w.goal_geom,
-                       failure=w.failure_geom, theta=w.theta, tau=tau, resolution=res)
+        dec = classify(
+            pts,
+            np.ones(len(pts), dtype=bool),
+            w.scene,
+            goal=w.goal_geom,
+            failure=w.failure_geom,
+            theta=w.theta,
+            tau=tau,
+            resolution=res,
+        )
         self.decision = dec
         if dec.label == "G":
             return -1.0
@@ -268,7 +293,9 @@ class OraclePolicy:
     def __init__(self, env) -> None:
         envs = getattr(env, "envs", None)
         if envs is None and hasattr(env, "remotes"):
-            raise TypeError("OraclePolicy needs in-process envs: use DummyVecEnv, not SubprocVecEnv")
+            raise TypeError(
+                "OraclePolicy needs in-process envs: use DummyVecEnv, not SubprocVecEnv"
+            )
         self.vectorized = envs is not None
         self.envs = [e.unwrapped for e in (envs if envs is not None else [env])]
         for e in self.envs:
@@ -283,17 +310,30 @@ class OraclePolicy:
         """Forget all episode state (called automatically at episode starts)."""
         self.drivers = [_Driver(e) for e in self.envs]
 
-    def predict(self, observation: Any, state: Any = None, episode_start: Any = None,
-                deterministic: bool = True) -> tuple[np.ndarray, Any]:
+    def predict(
+        self,
+        observation: Any,
+        state: Any = None,
+        episode_start: Any = None,
+        deterministic: bool = True,
+    ) -> tuple[np.ndarray, Any]:
         """Actions for the current state of the bound env(s); ``(actions, state)`` as in SB3."""
-        starts = np.zeros(len(self.envs), dtype=bool) if episode_start is None \
+        starts = (
+            np.zeros(len(self.envs), dtype=bool)
+            if episode_start is None
             else np.atleast_1d(np.asarray(episode_start, dtype=bool))
+        )
         actions = []
         for i, env in enumerate(self.envs):
             drv = self.drivers[i]
             new = bool(starts[i]) if i < len(starts) else False
-            if not new and env.spec_kind != "placement" and drv.steps > 0 \
-                    and env.pose is not None and np.allclose(env.pose, env.start, atol=0):
+            if (
+                not new
+                and env.spec_kind != "placement"
+                and drv.steps > 0
+                and env.pose is not None
+                and np.allclose(env.pose, env.start, atol=0)
+            ):
                 new = True  # the env was reset behind our back
             if new:
                 drv = self.drivers[i] = _Driver(env)
@@ -322,8 +362,9 @@ class OraclePolicy:
             decide = drv.decide(final)
             if decide == 0.0 and drv.looking:
                 # re-aim: sweep by a fraction of the beam spacing around the planned aim
-                spacing = (2 * math.pi if env.sensor.fov >= 2 * math.pi - 1e-12 else env.sensor.fov) \
-                    / max(env.sensor.n_beams, 1)
+                spacing = (
+                    2 * math.pi if env.sensor.fov >= 2 * math.pi - 1e-12 else env.sensor.fov
+                ) / max(env.sensor.n_beams, 1)
                 drv.dither += 1
                 offset = spacing * ((drv.dither % 8) / 8.0 - 0.5)
                 a[2] = np.clip(_wrap(drv.plan.aim + offset - env.pose[2]) / env.max_turn, -1, 1)
@@ -340,7 +381,9 @@ class OraclePolicy:
         # the most robust placement: the pole of inaccessibility of the largest part
         parts = shapely.get_parts(feasible)
         big = parts[np.argmax(shapely.area(parts))]
-        p = np.asarray(shapely.maximum_inscribed_circle(big, 1e-4 * w.diameter).boundary.geoms[0].coords[0])
+        p = np.asarray(
+            shapely.maximum_inscribed_circle(big, 1e-4 * w.diameter).boundary.geoms[0].coords[0]
+        )
         psi, _ = _aim_for(w, p)
         lo, hi = w.lo, w.hi
         xy = 2 * (p - lo) / (hi - lo) - 1

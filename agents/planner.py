@@ -288,9 +288,7 @@ def _dijkstra(n: int, i: np.ndarray, j: np.ndarray, w: np.ndarray) -> tuple[np.n
     return dist, pred
 
 
-def _goal_candidates(
-    target: BaseGeometry, nodes: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
+def _goal_candidates(target: BaseGeometry, nodes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """End-point candidates for each node: (node index, point) pairs.
 
     For a node u the exact end point is the point of ``target`` nearest to u among those u sees;
@@ -465,9 +463,7 @@ def _points_of(geom_or_points: Any) -> np.ndarray:
     return pts
 
 
-def best_aim(
-    p: Any, target: Any, fov: float, eps_aim: float = 0.0
-) -> tuple[float, float]:
+def best_aim(p: Any, target: Any, fov: float, eps_aim: float = 0.0) -> tuple[float, float]:
     """Aim that keeps the whole convex set ``target`` in the field of view with the most margin.
 
     Parameters

@@ -51,8 +51,12 @@ class RandomPolicy:
     dimension is taken as a batch.
     """
 
-    def __init__(self, action_space: spaces.Space, seed: int | None = None,
-                 observation_space: spaces.Space | None = None) -> None:
+    def __init__(
+        self,
+        action_space: spaces.Space,
+        seed: int | None = None,
+        observation_space: spaces.Space | None = None,
+    ) -> None:
         # a private copy: seeding must not touch the env's own action space
         self.action_space = copy.deepcopy(action_space)
         self.observation_space = observation_space
@@ -68,8 +72,13 @@ class RandomPolicy:
             return o.shape[0] if o.ndim == len(shape) + 1 else None
         return o.shape[0] if o.ndim >= 2 else None
 
-    def predict(self, observation: Any, state: Any = None, episode_start: Any = None,
-                deterministic: bool = True):
+    def predict(
+        self,
+        observation: Any,
+        state: Any = None,
+        episode_start: Any = None,
+        deterministic: bool = True,
+    ):
         n = self._n_batch(observation)
         if n is None:
             return np.asarray(self.action_space.sample()), state
@@ -95,8 +104,11 @@ def policy_label(spec: str) -> str:
     if spec in ("oracle", "random"):
         return spec
     p = Path(spec)
-    return p.stem if p.stem not in ("best_model", "final_model", "model") else \
-        f"{p.parent.name}/{p.stem}"
+    return (
+        p.stem
+        if p.stem not in ("best_model", "final_model", "model")
+        else f"{p.parent.name}/{p.stem}"
+    )
 
 
 def load_policy(spec: str, env, *, seed: int = 0, device: str = "cpu"):

@@ -361,7 +361,14 @@ def classify(
     n = len(pts)
     if n < min_points:
         return Decision(
-            "not_seen", math.inf, math.inf, None, None, n, tau, frac,
+            "not_seen",
+            math.inf,
+            math.inf,
+            None,
+            None,
+            n,
+            tau,
+            frac,
             f"only {n} reading(s) differ from the static map (need {min_points}): "
             "the target is not in view; move or re-aim",
         )

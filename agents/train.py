@@ -60,8 +60,15 @@ __all__ = [
 CONFIG_DIR = Path(__file__).parent / "configs"
 #: offset between the training seed and the periodic-evaluation env's seed
 EVAL_SEED_OFFSET = 10_000
-_META_KEYS = ("n_timesteps", "n_envs", "policy", "env_kwargs", "eval_freq", "n_eval_episodes",
-              "vec_env")
+_META_KEYS = (
+    "n_timesteps",
+    "n_envs",
+    "policy",
+    "env_kwargs",
+    "eval_freq",
+    "n_eval_episodes",
+    "vec_env",
+)
 
 
 def package_version() -> str:
@@ -115,8 +122,10 @@ def load_hyperparams(algo: str, env_id: str, config: str | Path | None = None) -
         return dict(data["default"] or {})
     if config is None:
         known = ", ".join(k for k in data if "/" in str(k)) or "none"
-        raise KeyError(f"{path} has no section for {env_id!r} (sections: {known}); "
-                       "pass --config FILE with hyperparameters for it")
+        raise KeyError(
+            f"{path} has no section for {env_id!r} (sections: {known}); "
+            "pass --config FILE with hyperparameters for it"
+        )
     if any("/" in str(k) for k in data):  # a zoo-style file, just not for this env
         raise KeyError(f"{path} has no section for {env_id!r}")
     return dict(data)
@@ -127,8 +136,14 @@ def _activation(name: Any):
 
     if not isinstance(name, str):
         return name
-    table = {"tanh": nn.Tanh, "relu": nn.ReLU, "elu": nn.ELU, "leaky_relu": nn.LeakyReLU,
-             "gelu": nn.GELU, "silu": nn.SiLU}
+    table = {
+        "tanh": nn.Tanh,
+        "relu": nn.ReLU,
+        "elu": nn.ELU,
+        "leaky_relu": nn.LeakyReLU,
+        "gelu": nn.GELU,
+        "silu": nn.SiLU,
+    }
     try:
         return table[name.lower().removeprefix("nn.")]
     except KeyError:
@@ -182,8 +197,9 @@ def check_algo_env(algo: str, env_id: str, env_kwargs: dict) -> None:
             "Use ppo, a2c, sac or td3 for this env."
         )
     if algo in ("sac", "td3") and not isinstance(space, gym.spaces.Box):
-        raise ValueError(f"{algo.upper()} needs a continuous (Box) action space; "
-                         f"{env_id} has {space}")
+        raise ValueError(
+            f"{algo.upper()} needs a continuous (Box) action space; {env_id} has {space}"
+        )
 
 
 def _eval_callback_cls():
@@ -209,12 +225,17 @@ def _eval_callback_cls():
                 if key > self.best_key:
                     self.best_key = key
                     self.model.save(self.best_path)
-                    self.best_info = {"timesteps": int(self.num_timesteps), "success_rate": sr,
-                                      "mean_return": float(self.last_mean_reward)}
+                    self.best_info = {
+                        "timesteps": int(self.num_timesteps),
+                        "success_rate": sr,
+                        "mean_return": float(self.last_mean_reward),
+                    }
                     self.write_config(self.best_path.with_suffix(".yaml"), self.best_info)
                     if self.verbose:
-                        print(f"new best model: success {sr:.3f}, return "
-                              f"{self.last_mean_reward:.3f} at {self.num_timesteps} steps")
+                        print(
+                            f"new best model: success {sr:.3f}, return "
+                            f"{self.last_mean_reward:.3f} at {self.num_timesteps} steps"
+                        )
             return cont
 
     return BestSuccessEvalCallback
@@ -260,8 +281,9 @@ def train(
     if algo not in ALGOS:
         raise ValueError(f"unknown algorithm {algo!r}; choose one of {', '.join(ALGOS)}")
     if env_id not in gym.registry:
-        raise ValueError(f"unknown env id {env_id!r}; sensorplan ids: "
-                         f"{', '.join(sensorplan_gym.ENV_IDS)}")
+        raise ValueError(
+            f"unknown env id {env_id!r}; sensorplan ids: {', '.join(sensorplan_gym.ENV_IDS)}"
+        )
     hp = load_hyperparams(algo, env_id, config)
     resolved_env_kwargs = dict(hp.pop("env_kwargs", None) or {})
     resolved_env_kwargs.update(env_kwargs or {})
@@ -330,11 +352,24 @@ def train(
             "gymnasium": str(gym.__version__),
             "python": platform.python_version(),
         },
-        "command": " ".join(["sensorplan", "train", "--env", env_id, "--algo", algo,
-                             "--timesteps", str(n_timesteps), "--seed", str(seed),
-                             "--n-envs", str(n_envs)]
-                            + (["--env-kwargs", json.dumps(env_kwargs)] if env_kwargs else [])
-                            + (["--config", str(config)] if config else [])),
+        "command": " ".join(
+            [
+                "sensorplan",
+                "train",
+                "--env",
+                env_id,
+                "--algo",
+                algo,
+                "--timesteps",
+                str(n_timesteps),
+                "--seed",
+                str(seed),
+                "--n-envs",
+                str(n_envs),
+            ]
+            + (["--env-kwargs", json.dumps(env_kwargs)] if env_kwargs else [])
+            + (["--config", str(config)] if config else [])
+        ),
     }
     t0 = time.perf_counter()
 
@@ -348,8 +383,9 @@ def train(
             f.write(f"# resolved config written by sensorplan train ({stamp})\n")
             yaml.safe_dump(rec, f, sort_keys=False)
 
-    model = algo_class(algo)(policy, venv, seed=seed, verbose=0 if verbose < 2 else 1,
-                             device=device, **kwargs)
+    model = algo_class(algo)(
+        policy, venv, seed=seed, verbose=0 if verbose < 2 else 1, device=device, **kwargs
+    )
     callback = _eval_callback_cls()(
         eval_env,
         best_path=out / "best_model.zip",
@@ -361,12 +397,19 @@ def train(
         verbose=verbose,
     )
     if verbose:
-        print(f"training {algo.upper()} on {env_id} {resolved_env_kwargs} for {n_timesteps} steps, "
-              f"seed {seed}, {n_envs} x {vec_cls.__name__} -> {out}", flush=True)
+        print(
+            f"training {algo.upper()} on {env_id} {resolved_env_kwargs} for {n_timesteps} steps, "
+            f"seed {seed}, {n_envs} x {vec_cls.__name__} -> {out}",
+            flush=True,
+        )
     try:
         warnings.filterwarnings("ignore", message="Training and eval env are not of the same type")
-        model.learn(total_timesteps=n_timesteps, callback=callback, progress_bar=progress_bar,
-                    tb_log_name=f"{algo}_s{seed}")
+        model.learn(
+            total_timesteps=n_timesteps,
+            callback=callback,
+            progress_bar=progress_bar,
+            tb_log_name=f"{algo}_s{seed}",
+        )
     finally:
         venv.close()
     train_time = time.perf_counter() - t0
@@ -375,21 +418,28 @@ def train(
     write_config(out / "final_model.yaml")
     if callback.best_info is None:  # no evaluation ran (short run): the final model is the best
         shutil.copyfile(out / "final_model.zip", out / "best_model.zip")
-        write_config(out / "best_model.yaml", {"timesteps": int(model.num_timesteps),
-                                               "success_rate": None, "mean_return": None})
+        write_config(
+            out / "best_model.yaml",
+            {"timesteps": int(model.num_timesteps), "success_rate": None, "mean_return": None},
+        )
     else:
         # rewrite so the best model's config carries the total training time too
         write_config(out / "best_model.yaml", callback.best_info)
     eval_env.close()
-    record.update({
-        "out": str(out),
-        "best_model": str(out / "best_model.zip"),
-        "final_model": str(out / "final_model.zip"),
-        "best": callback.best_info,
-    })
+    record.update(
+        {
+            "out": str(out),
+            "best_model": str(out / "best_model.zip"),
+            "final_model": str(out / "final_model.zip"),
+            "best": callback.best_info,
+        }
+    )
     if verbose:
-        print(f"done in {train_time:.1f} s; best model {out / 'best_model.zip'} "
-              f"{callback.best_info or ''}", flush=True)
+        print(
+            f"done in {train_time:.1f} s; best model {out / 'best_model.zip'} "
+            f"{callback.best_info or ''}",
+            flush=True,
+        )
     return record
 
 

@@ -41,16 +41,20 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--episodes", type=int, default=100)
     ap.add_argument("--random-scenes", type=int, default=200)
     args = ap.parse_args(argv)
-    rows = ["| env | scene | episodes | successes | success rate | excluded (no placement) |",
-            "| --- | --- | ---: | ---: | ---: | ---: |"]
+    rows = [
+        "| env | scene | episodes | successes | success rate | excluded (no placement) |",
+        "| --- | --- | ---: | ---: | ---: | ---: |",
+    ]
     t0 = time.perf_counter()
     for env_id in ENVS:
         for scene in SCENES:
             env = gym.make(env_id, scene=scene)
             pol = OraclePolicy(env)
             wins = sum(episode(env, pol, SEED0 + i) for i in range(args.episodes))
-            rows.append(f"| {env_id} | {scene} | {args.episodes} | {wins} | "
-                        f"{wins / args.episodes:.3f} | 0 |")
+            rows.append(
+                f"| {env_id} | {scene} | {args.episodes} | {wins} | "
+                f"{wins / args.episodes:.3f} | 0 |"
+            )
             print(rows[-1], flush=True)
         rng = np.random.default_rng(SEED0)
         wins = runs = excluded = 0
@@ -65,8 +69,10 @@ def main(argv: list[str] | None = None) -> None:
                 continue
             runs += 1
             wins += episode(env, OraclePolicy(env), SEED0 + runs)
-        rows.append(f"| {env_id} | random ({args.random_scenes} scenes) | {runs} | {wins} | "
-                    f"{wins / max(runs, 1):.3f} | {excluded} |")
+        rows.append(
+            f"| {env_id} | random ({args.random_scenes} scenes) | {runs} | {wins} | "
+            f"{wins / max(runs, 1):.3f} | {excluded} |"
+        )
         print(rows[-1], flush=True)
     table = "\n".join(rows)
     out = Path(__file__).parent / "results" / "oracle.md"

@@ -46,27 +46,45 @@ def _point_variant(d: dict) -> dict:
 
 def _queries() -> list[tuple[str, str, Callable[[Scene], object]]]:
     """(name, which scene variant, call)."""
+
     def pose(s: Scene) -> tuple[float, float, float]:
         c = s.goal_geom.representative_point()
         return (c.x, c.y, 0.3)
 
     return [
         ("complete, stationary", "poly", lambda s: complete_region(s, target_at=pose(s))),
-        ("complete, translating (G polygon)", "poly",
-         lambda s: complete_region(s, target_in="goal", theta=0.3)),
-        ("complete, rotating (theta=None)", "poly",
-         lambda s: complete_region(s, target_in="goal", theta=None)),
+        (
+            "complete, translating (G polygon)",
+            "poly",
+            lambda s: complete_region(s, target_in="goal", theta=0.3),
+        ),
+        (
+            "complete, rotating (theta=None)",
+            "poly",
+            lambda s: complete_region(s, target_in="goal", theta=None),
+        ),
         ("partial, stationary", "poly", lambda s: partial_region(s, target_at=pose(s))),
-        ("partial, eps_aim=5deg", "poly",
-         lambda s: partial_region(s, target_at=pose(s), eps_aim=math.radians(5))),
-        ("recognizable, complete (polygon G/H)", "poly",
-         lambda s: recognizable_region(s, model="complete", theta=0.3)),
-        ("recognizable, partial (point G/H)", "point",
-         lambda s: recognizable_region(s, model="partial", theta=0.3)),
+        (
+            "partial, eps_aim=5deg",
+            "poly",
+            lambda s: partial_region(s, target_at=pose(s), eps_aim=math.radians(5)),
+        ),
+        (
+            "recognizable, complete (polygon G/H)",
+            "poly",
+            lambda s: recognizable_region(s, model="complete", theta=0.3),
+        ),
+        (
+            "recognizable, partial (point G/H)",
+            "point",
+            lambda s: recognizable_region(s, model="partial", theta=0.3),
+        ),
     ]
 
 
-def _time(fn: Callable[[Scene], object], d: dict, reps: int, warm: bool = True) -> tuple[float, float]:
+def _time(
+    fn: Callable[[Scene], object], d: dict, reps: int, warm: bool = True
+) -> tuple[float, float]:
     """Median and IQR (seconds) of ``fn``.
 
     ``warm``: repeated calls on one Scene (its cached visibility domain reused, as
@@ -109,8 +127,17 @@ def _grid_oracle(d: dict, n: int) -> tuple[float, int]:
             a = a[::-1]
         return pv.Polygon([pv.Point(float(x), float(y)) for x, y in a])
 
-    calcs = [(p, pv.VisibilityPolygonCalculator(pv.PolygonWithHoles(
-        ring(p.exterior.coords, True), [ring(h.coords, False) for h in p.interiors]))) for p in polys]
+    calcs = [
+        (
+            p,
+            pv.VisibilityPolygonCalculator(
+                pv.PolygonWithHoles(
+                    ring(p.exterior.coords, True), [ring(h.coords, False) for h in p.interiors]
+                )
+            ),
+        )
+        for p in polys
+    ]
     x0, y0, x1, y1 = s.bounds_geom.bounds
     xs = np.linspace(x0, x1, n + 2)[1:-1]
     ys = np.linspace(y0, y1, n + 2)[1:-1]
@@ -151,8 +178,11 @@ def main(argv: list[str] | None = None) -> str:
     medians: dict[tuple[str, bool], list[float]] = {}
     for warm in (True, False):
         lines.append("")
-        lines.append("**Warm** (repeated queries on one loaded Scene):" if warm else
-                     "**Cold** (first query on a freshly loaded Scene, building its visibility domain):")
+        lines.append(
+            "**Warm** (repeated queries on one loaded Scene):"
+            if warm
+            else "**Cold** (first query on a freshly loaded Scene, building its visibility domain):"
+        )
         lines.append("")
         lines.append(head)
         lines.append("|" + "---|" * (len(EDGES) + 2))
@@ -173,11 +203,13 @@ def main(argv: list[str] | None = None) -> str:
         f"scenes `scene_with_edges(n, seed={SEED})` (6-vertex target, polygonal G/H; the point "
         "variant shrinks G and H to a point inside each). Growth exponent: slope of "
         "log(time) vs log(edges).",
-        f"Machine: {platform.processor() or platform.machine()}, Python {platform.python_version()}, "
+        f"Machine: {platform.processor() or platform.machine()}, "
+        f"Python {platform.python_version()}, "
         f"shapely {shapely.__version__}, numpy {np.__version__}.",
     ]
     try:
         import pyvispoly  # noqa: F401
+
         have_pv = True
     except ImportError:
         have_pv = False
@@ -189,11 +221,16 @@ def main(argv: list[str] | None = None) -> str:
         est = secs * scale
         exact = medians[("complete, stationary", True)][EDGES.index(n_bench)]
         cold = medians[("complete, stationary", False)][EDGES.index(n_bench)]
-        how = "measured" if grid == 100 else f"measured on a {grid}x{grid} subgrid and scaled x{scale:g}"
+        how = (
+            "measured"
+            if grid == 100
+            else f"measured on a {grid}x{grid} subgrid and scaled x{scale:g}"
+        )
         notes += [
             "",
-            f"Alternative without this package: classify a 100x100 grid of placements with pyvispoly "
-            f"(CGAL) visibility polygons for the stationary complete query on the {actual[n_bench]}-edge "
+            "Alternative without this package: classify a 100x100 grid of placements with "
+            "pyvispoly (CGAL) visibility polygons for the stationary complete query on the "
+            f"{actual[n_bench]}-edge "
             f"scene: {est:.3f} s ({how}); exact complete_region: {exact * 1e3:.2f} ms warm, "
             f"{cold * 1e3:.2f} ms cold; speed-up x{est / exact:,.0f} warm, x{est / cold:,.0f} cold "
             "(and the grid answer is only a raster).",

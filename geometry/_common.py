@@ -23,7 +23,7 @@ QUAD_SEGS = 16
 #: Radius factor making a polygonal buffer contain the exact disc buffer.
 OUTER = 1.0 / math.cos(math.pi / (4 * QUAD_SEGS))
 
-_DOMAINS: "weakref.WeakKeyDictionary[Scene, Domain]" = weakref.WeakKeyDictionary()
+_DOMAINS: weakref.WeakKeyDictionary[Scene, Domain] = weakref.WeakKeyDictionary()
 
 
 def scene_domain(scene: Scene) -> Domain:
@@ -112,15 +112,23 @@ def target_spec(
         try:
             x, y, th = (float(v) for v in target_at)
         except (TypeError, ValueError):
-            raise ValueError(f"target_at must be (x, y, theta) numbers, got {target_at!r}") from None
+            raise ValueError(
+                f"target_at must be (x, y, theta) numbers, got {target_at!r}"
+            ) from None
         if not all(math.isfinite(v) for v in (x, y, th)):
             raise ValueError(f"target_at must be finite, got {target_at!r}")
         if theta not in (0.0, None) and theta != th:
             raise ValueError("with target_at the orientation is target_at[2]; do not pass theta")
         area = scene.target_at(x, y, th)
         pts = hull_points(area)
-        spec = TargetSpec(area, pts, 0.0, np.asarray(area.centroid.coords[0]), (x, y, th),
-                          f"target at ({x:g}, {y:g}, {th:g})")
+        spec = TargetSpec(
+            area,
+            pts,
+            0.0,
+            np.asarray(area.centroid.coords[0]),
+            (x, y, th),
+            f"target at ({x:g}, {y:g}, {th:g})",
+        )
     else:
         region = _region(scene, target_in)
         label = f"target in {target_in}" if isinstance(target_in, str) else "target in region"
@@ -128,8 +136,11 @@ def target_spec(
             r = float(scene.target_radius)
             pts = hull_points(region)
             area = region.buffer(r * OUTER, quad_segs=QUAD_SEGS)
-            center = np.asarray(shapely.convex_hull(region).centroid.coords[0]) if len(pts) > 2 \
+            center = (
+                np.asarray(shapely.convex_hull(region).centroid.coords[0])
+                if len(pts) > 2
                 else pts.mean(axis=0)
+            )
             spec = TargetSpec(area, pts, r, center, None, label + " (any orientation)")
         else:
             th = float(theta)
@@ -139,8 +150,9 @@ def target_spec(
             area = minkowski_sum(a, region)
             pts = hull_points(area)
             c = shapely.convex_hull(area).centroid
-            spec = TargetSpec(area, pts, 0.0, np.asarray(c.coords[0]), None,
-                              label + f" (orientation {th:g})")
+            spec = TargetSpec(
+                area, pts, 0.0, np.asarray(c.coords[0]), None, label + f" (orientation {th:g})"
+            )
     scene.check_clear(spec.hull, spec.label)
     return spec
 
@@ -148,10 +160,14 @@ def target_spec(
 def _region(scene: Scene, which: str | shapely.Geometry) -> shapely.Geometry:
     if isinstance(which, str):
         if which not in ("goal", "failure"):
-            raise ValueError(f"target_in must be 'goal', 'failure' or a shapely Polygon/Point, got {which!r}")
+            raise ValueError(
+                f"target_in must be 'goal', 'failure' or a shapely Polygon/Point, got {which!r}"
+            )
         return scene.region(which)
     if not isinstance(which, shapely.Geometry) or which.geom_type not in ("Polygon", "Point"):
-        raise ValueError(f"target_in must be 'goal', 'failure' or a shapely Polygon/Point, got {which!r}")
+        raise ValueError(
+            f"target_in must be 'goal', 'failure' or a shapely Polygon/Point, got {which!r}"
+        )
     if which.is_empty or not which.is_valid:
         raise ValueError(f"target_in region is empty or invalid: {shapely.is_valid_reason(which)}")
     if not scene.free_space.covers(which):
@@ -170,7 +186,9 @@ def check_eps(name: str, value: float) -> float:
     return v
 
 
-def shrink_for_position(region: shapely.Geometry, allowed: shapely.Geometry, eps_pos: float) -> shapely.Geometry:
+def shrink_for_position(
+    region: shapely.Geometry, allowed: shapely.Geometry, eps_pos: float
+) -> shapely.Geometry:
     """Paper section 4, positional uncertainty: grow the shadows by the eps-disc.
 
     ``allowed`` is the placement space (free space minus the target area);

@@ -57,8 +57,12 @@ class Domain:
     def vert_wedge(self) -> np.ndarray:
         """(V, 2) free wedge ``(start, width)`` at every vertex: counter-clockwise
         from the direction of the next vertex to that of the previous one."""
-        a = np.arctan2(self.vert_next[:, 1] - self.vert[:, 1], self.vert_next[:, 0] - self.vert[:, 0])
-        b = np.arctan2(self.vert_prev[:, 1] - self.vert[:, 1], self.vert_prev[:, 0] - self.vert[:, 0])
+        a = np.arctan2(
+            self.vert_next[:, 1] - self.vert[:, 1], self.vert_next[:, 0] - self.vert[:, 0]
+        )
+        b = np.arctan2(
+            self.vert_prev[:, 1] - self.vert[:, 1], self.vert_prev[:, 0] - self.vert[:, 0]
+        )
         w = (b - a) % TAU
         return np.stack([a, np.where(w == 0.0, TAU, w)], axis=1)
 
@@ -69,7 +73,7 @@ class Domain:
         Each ring must already be oriented with the free region on its left.
         """
         segs, sring, stag, verts, prevs, nexts, vring = [], [], [], [], [], [], []
-        for r_i, (ring, tag) in enumerate(zip(rings, tags)):
+        for r_i, (ring, tag) in enumerate(zip(rings, tags, strict=False)):
             ring = np.asarray(ring, dtype=float)
             nxt = np.roll(ring, -1, axis=0)
             prv = np.roll(ring, 1, axis=0)
@@ -155,7 +159,14 @@ class Gaps:
 
     def part(self, a: int, b: int) -> Gaps:
         """Gaps ``a:b`` of a flat result of one viewpoint (see :func:`gaps_many`)."""
-        return Gaps(q=self.q[a], lo=self.lo[a:b], hi=self.hi[a:b], seg=self.seg[a:b], p0=self.p0[a:b], p1=self.p1[a:b])
+        return Gaps(
+            q=self.q[a],
+            lo=self.lo[a:b],
+            hi=self.hi[a:b],
+            seg=self.seg[a:b],
+            p0=self.p0[a:b],
+            p1=self.p1[a:b],
+        )
 
     q: np.ndarray
     lo: np.ndarray
@@ -258,9 +269,19 @@ def gaps_many(
     cols = [np.where(np.abs(d).max(axis=2) > tol, np.arctan2(d[..., 1], d[..., 0]), np.nan)]
     if extra is not None:
         cols.append(extra)
-    cols.append(np.stack([w1[:, 0], w1[:, 0] + w1[:, 1], w2[:, 0], w2[:, 0] + w2[:, 1],
-                          np.arctan2(along[:, 1], along[:, 0]),
-                          np.arctan2(-along[:, 1], -along[:, 0])], axis=1))
+    cols.append(
+        np.stack(
+            [
+                w1[:, 0],
+                w1[:, 0] + w1[:, 1],
+                w2[:, 0],
+                w2[:, 0] + w2[:, 1],
+                np.arctan2(along[:, 1], along[:, 0]),
+                np.arctan2(-along[:, 1], -along[:, 0]),
+            ],
+            axis=1,
+        )
+    )
     ang = np.concatenate(cols, axis=1)
     rel = (ang - start[:, None]) % TAU
     rel = np.where(np.isnan(rel) | (rel >= width[:, None]) | (rel <= 0.0), np.inf, rel)
@@ -294,12 +315,14 @@ def gaps_many(
         p0[ok] = _ray_line(qo[ok], lo[ok], sg)
         p1[ok] = _ray_line(qo[ok], hi[ok], sg)
     if flat:
-        return Gaps(q=qo, lo=lo, hi=hi, seg=seg, p0=p0, p1=p1), np.searchsorted(owner, np.arange(n + 1))
+        return Gaps(q=qo, lo=lo, hi=hi, seg=seg, p0=p0, p1=p1), np.searchsorted(
+            owner, np.arange(n + 1)
+        )
     cuts = np.searchsorted(owner, np.arange(1, n))
     return [
         Gaps(q=q[i], lo=l_, hi=h_, seg=s_, p0=a_, p1=b_)
         for i, (l_, h_, s_, a_, b_) in enumerate(
-            zip(*(np.split(x, cuts) for x in (lo, hi, seg, p0, p1)))
+            zip(*(np.split(x, cuts) for x in (lo, hi, seg, p0, p1)), strict=False)
         )
     ]
 
@@ -319,7 +342,9 @@ def _first_hits(dom: Domain, q: np.ndarray, phi: np.ndarray) -> np.ndarray:
     ones = np.ones_like(dx)
     den = np.stack([dx, dy], axis=1) @ np.stack([ey, -ex])
     t_num = np.stack([ones, -q[:, 0], q[:, 1]], axis=1) @ np.stack([x0 * ey - y0 * ex, ey, ex])
-    s_num = np.stack([dy, -dx, q[:, 1] * dx - q[:, 0] * dy], axis=1) @ np.stack([x0, y0, np.ones_like(x0)])
+    s_num = np.stack([dy, -dx, q[:, 1] * dx - q[:, 0] * dy], axis=1) @ np.stack(
+        [x0, y0, np.ones_like(x0)]
+    )
     with np.errstate(divide="ignore", invalid="ignore"):
         inv = 1.0 / den
         t = t_num * inv

@@ -96,7 +96,9 @@ def _complete(scene: Scene, spec: TargetSpec) -> shapely.Geometry:
     return polygonal(shapely.difference(vis, blocked))
 
 
-def tangent_wedges(u: np.ndarray, spec: TargetSpec, scale: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def tangent_wedges(
+    u: np.ndarray, spec: TargetSpec, scale: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Wedges u + cone(u - K) at points ``u``.
 
     Each wedge is bounded by the two tangents from ``u`` to the convex set K

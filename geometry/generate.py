@@ -92,13 +92,18 @@ def _room(rng: np.random.Generator, width: float, height: float, notches: int) -
     n = len(pts)
     for i in range(n):  # drop repeated and collinear vertices
         a, b, c = pts[i - 1], pts[i], pts[(i + 1) % n]
-        if np.allclose(a, b) or abs((b[0] - a[0]) * (c[1] - b[1]) - (b[1] - a[1]) * (c[0] - b[0])) < 1e-12:
+        if (
+            np.allclose(a, b)
+            or abs((b[0] - a[0]) * (c[1] - b[1]) - (b[1] - a[1]) * (c[0] - b[0])) < 1e-12
+        ):
             continue
         keep.append(b)
     return Polygon(keep)
 
 
-def _region(rng: np.random.Generator, center: np.ndarray, kind: str, size: float) -> Polygon | Point:
+def _region(
+    rng: np.random.Generator, center: np.ndarray, kind: str, size: float
+) -> Polygon | Point:
     if kind == "point":
         return Point(center)
     n = int(rng.integers(3, 7))
@@ -161,20 +166,45 @@ def random_scene(
     failure = failure or goal
     for _ in range(max_tries):
         d = _try_scene(
-            rng, n_obstacles=n_obstacles, target_edges=target_edges, goal=goal, failure=failure,
-            obstacle_vertices=obstacle_vertices, obstacle_sizes=obstacle_sizes,
-            room_size=room_size, notches=notches, convex_fraction=convex_fraction,
-            target_radius=target_radius, rotation_clear=rotation_clear, overlap=overlap,
-            margin=margin, name=name,
+            rng,
+            n_obstacles=n_obstacles,
+            target_edges=target_edges,
+            goal=goal,
+            failure=failure,
+            obstacle_vertices=obstacle_vertices,
+            obstacle_sizes=obstacle_sizes,
+            room_size=room_size,
+            notches=notches,
+            convex_fraction=convex_fraction,
+            target_radius=target_radius,
+            rotation_clear=rotation_clear,
+            overlap=overlap,
+            margin=margin,
+            name=name,
         )
         if d is not None:
             return d
     raise RuntimeError("random_scene: could not place the scene; relax the parameters")
 
 
-def _try_scene(rng: np.random.Generator, *, n_obstacles, target_edges, goal, failure,
-               obstacle_vertices, obstacle_sizes, room_size, notches, convex_fraction,
-               target_radius, rotation_clear, overlap, margin, name) -> dict[str, Any] | None:
+def _try_scene(
+    rng: np.random.Generator,
+    *,
+    n_obstacles,
+    target_edges,
+    goal,
+    failure,
+    obstacle_vertices,
+    obstacle_sizes,
+    room_size,
+    notches,
+    convex_fraction,
+    target_radius,
+    rotation_clear,
+    overlap,
+    margin,
+    name,
+) -> dict[str, Any] | None:
     if obstacle_sizes is None:
         n_obs = int(rng.integers(2, 8)) if n_obstacles is None else int(n_obstacles)
         lo, hi = obstacle_vertices
@@ -279,7 +309,9 @@ def _try_scene(rng: np.random.Generator, *, n_obstacles, target_edges, goal, fai
     return d
 
 
-def scene_with_edges(n_edges: int, seed: int, *, goal: Literal["point", "polygon"] = "polygon") -> dict[str, Any]:
+def scene_with_edges(
+    n_edges: int, seed: int, *, goal: Literal["point", "polygon"] = "polygon"
+) -> dict[str, Any]:
     """A benchmark scene whose walls plus obstacles have about ``n_edges`` edges.
 
     A rectangular room (4 walls) or, for ``n_edges >= 40``, an L-shaped room
@@ -304,7 +336,13 @@ def scene_with_edges(n_edges: int, seed: int, *, goal: Literal["point", "polygon
     area = 60.0 + 10.0 * n_obs
     room_size = (math.sqrt(area * 1.2), math.sqrt(area / 1.2))
     return random_scene(
-        rng, obstacle_sizes=sizes, target_edges=6, goal=goal, room_size=room_size,
-        notches=notches, target_radius=0.6, name=f"bench-{n_edges}-edges-seed{seed}",
+        rng,
+        obstacle_sizes=sizes,
+        target_edges=6,
+        goal=goal,
+        room_size=room_size,
+        notches=notches,
+        target_radius=0.6,
+        name=f"bench-{n_edges}-edges-seed{seed}",
         max_tries=500,
     )

@@ -71,7 +71,9 @@ def partial_region(
     eps_pos = check_eps("eps_pos", eps_pos)
     eps_aim = check_eps("eps_aim", eps_aim)
     if target_in is not None:
-        raise NotImplementedError(f"partial_region(target_in=...) is not implemented yet: {SWEEP_TOPIC}")
+        raise NotImplementedError(
+            f"partial_region(target_in=...) is not implemented yet: {SWEEP_TOPIC}"
+        )
     if target_at is None:
         raise ValueError("give target_at=(x, y, theta)")
     spec = target_spec(scene, target_at, None, theta)
@@ -90,7 +92,9 @@ def _hole_ring(poly: shapely.Polygon) -> np.ndarray:
     return c
 
 
-def weak_visibility(env: Domain, ring: np.ndarray, wanted: np.ndarray, eps_aim: float = 0.0) -> shapely.Geometry:
+def weak_visibility(
+    env: Domain, ring: np.ndarray, wanted: np.ndarray, eps_aim: float = 0.0
+) -> shapely.Geometry:
     """Placements that see some wanted piece of a target boundary.
 
     Parameters
@@ -107,7 +111,6 @@ def weak_visibility(env: Domain, ring: np.ndarray, wanted: np.ndarray, eps_aim: 
     Union of the visibility triangles (shapely geometry, world frame), not yet
     clipped against the target itself.
     """
-    m = len(ring)
     dom = env.with_ring(ring, UNWANTED, np.where(wanted, WANTED, UNWANTED))
     fans: list[shapely.Geometry] = []
     # 1. anchors on the target: endpoints of wanted pieces, seen from the front
@@ -120,7 +123,7 @@ def weak_visibility(env: Domain, ring: np.ndarray, wanted: np.ndarray, eps_aim: 
         dirs = np.stack([e_out, e_in], axis=1)  # (k, 2, 2)
         ang = np.arctan2(dirs[..., 1], dirs[..., 0])
         extra = np.concatenate([ang + np.pi, ang], axis=1)
-        for gi, i in zip(gaps_many(dom, ring[anchors], extra=extra), anchors):
+        for gi, i in zip(gaps_many(dom, ring[anchors], extra=extra), anchors, strict=False):
             mid = 0.5 * (gi.lo + gi.hi)
             d = np.stack([np.cos(mid), np.sin(mid)], axis=1)
             front = np.zeros(len(mid), dtype=bool)
@@ -137,7 +140,7 @@ def weak_visibility(env: Domain, ring: np.ndarray, wanted: np.ndarray, eps_aim: 
         centre = ring.mean(axis=0)
         base = np.arctan2(centre[1] - v[:, 1], centre[0] - v[:, 0])
         rel = (rel - base[:, None] + np.pi) % TAU - np.pi
-        on_target = (np.abs(ring[None, :, :] - v[:, None, :]).max(axis=2) <= 1e-12 * dom.scale)
+        on_target = np.abs(ring[None, :, :] - v[:, None, :]).max(axis=2) <= 1e-12 * dom.scale
         lo = np.where(on_target, np.inf, rel).min(axis=1)
         hi = np.where(on_target, -np.inf, rel).max(axis=1)
         ok = hi - lo > 1e-12
@@ -216,4 +219,3 @@ def _fans(g: Gaps, mask: np.ndarray, dom: Domain, eps_aim: float) -> list[shapel
             pts[2::2] = g.p1[piece]
             out.append(clean_polygon(pts, 1e-10 * dom.scale))
     return out
-

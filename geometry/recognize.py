@@ -37,7 +37,8 @@ __all__ = ["overlap_segments", "recognizable_region"]
 
 ROTATING_PARTIAL = (
     "the partial-visibility model for a target of unknown orientation (theta=None) is not "
-    "given by the paper (its conclusion leaves it to future work); use model='complete' or a fixed theta"
+    "given by the paper (its conclusion leaves it to future work); use model='complete' "
+    "or a fixed theta"
 )
 
 
@@ -89,7 +90,10 @@ def recognizable_region(
     regions = []
     for me, other in ((g, h), (h, g)):
         spec = target_spec(scene, (me.x, me.y, th), None, None)
-        ring, wanted = _split_ring(_ccw(spec.area), _cuts(_ccw(spec.area), _ccw(scene.target_at(other.x, other.y, th)), scene.diameter))
+        ring, wanted = _split_ring(
+            _ccw(spec.area),
+            _cuts(_ccw(spec.area), _ccw(scene.target_at(other.x, other.y, th)), scene.diameter),
+        )
         ring_cw, wanted_cw = ring[::-1], np.roll(wanted[::-1], -1)
         reg = weak_visibility(scene_domain(scene), ring_cw, wanted_cw, eps_aim)
         reg = polygonal(shapely.difference(reg, spec.area))
@@ -112,7 +116,10 @@ def overlap_segments(scene: Scene, theta: float = 0.0) -> list[shapely.LineStrin
     ag = _ccw(scene.target_at(g.x, g.y, theta))
     ah = _ccw(scene.target_at(h.x, h.y, theta))
     e = np.roll(ag, -1, axis=0) - ag
-    return [shapely.LineString([ag[i] + t0 * e[i], ag[i] + t1 * e[i]]) for i, t0, t1 in _cuts(ag, ah, scene.diameter)]
+    return [
+        shapely.LineString([ag[i] + t0 * e[i], ag[i] + t1 * e[i]])
+        for i, t0, t1 in _cuts(ag, ah, scene.diameter)
+    ]
 
 
 def _ccw(poly: shapely.Polygon) -> np.ndarray:
@@ -133,7 +140,7 @@ def _cuts(a: np.ndarray, b: np.ndarray, scale: float) -> list[tuple[int, float, 
     off = b[None, :, :] - a[:, None, :]
     collinear = np.abs(ua[:, None, 0] * off[..., 1] - ua[:, None, 1] * off[..., 0]) <= tol
     out = []
-    for i, j in zip(*np.nonzero(same & collinear)):
+    for i, j in zip(*np.nonzero(same & collinear), strict=False):
         s0 = float(off[i, j] @ ua[i]) / la[i]
         s1 = s0 + lb[j] / la[i]
         t0, t1 = max(0.0, s0), min(1.0, s1)
@@ -142,7 +149,9 @@ def _cuts(a: np.ndarray, b: np.ndarray, scale: float) -> list[tuple[int, float, 
     return out
 
 
-def _split_ring(ring: np.ndarray, cuts: list[tuple[int, float, float]]) -> tuple[np.ndarray, np.ndarray]:
+def _split_ring(
+    ring: np.ndarray, cuts: list[tuple[int, float, float]]
+) -> tuple[np.ndarray, np.ndarray]:
     """Insert the cut points into a CCW ring; returns (new ring, wanted flag per edge)."""
     pts, wanted = [], []
     e = np.roll(ring, -1, axis=0) - ring
@@ -153,7 +162,7 @@ def _split_ring(ring: np.ndarray, cuts: list[tuple[int, float, float]]) -> tuple
             marks.setdefault(t0, True)
             marks.setdefault(t1, True)
         ts = sorted(marks)
-        for a, b in zip(ts[:-1], ts[1:]):
+        for a, b in zip(ts[:-1], ts[1:], strict=False):
             mid = 0.5 * (a + b)
             covered = any(t0 <= mid <= t1 for t0, t1 in spans)
             pts.append(ring[i] + a * e[i])

@@ -112,8 +112,9 @@ def _as_oracle(o: Any) -> VisOracle:
     return o if isinstance(o, VisOracle) else VisOracle(o)
 
 
-def sees_completely(space: Any, p: Sequence[float], target: shapely.Geometry,
-                    vis: Polygon | None = None) -> bool:
+def sees_completely(
+    space: Any, p: Sequence[float], target: shapely.Geometry, vis: Polygon | None = None
+) -> bool:
     """True iff every point of ``target`` is visible from ``p`` (target subset of V(p)).
 
     ``space`` is a :class:`VisOracle`, a Scene or a free-space geometry (the target
@@ -126,8 +127,9 @@ def sees_completely(space: Any, p: Sequence[float], target: shapely.Geometry,
     return shapely.difference(target, v).area <= AREA_REL * target.area
 
 
-def sees_partially(space: Any, p: Sequence[float], target: shapely.Geometry,
-                   vis: Polygon | None = None) -> bool:
+def sees_partially(
+    space: Any, p: Sequence[float], target: shapely.Geometry, vis: Polygon | None = None
+) -> bool:
     """True iff ``target`` meets V(p) in positive area (above ``AREA_REL * target.area``)."""
     v = _as_oracle(space).visibility(p) if vis is None else vis
     if v.is_empty:
@@ -135,8 +137,13 @@ def sees_partially(space: Any, p: Sequence[float], target: shapely.Geometry,
     return shapely.intersection(target, v).area > AREA_REL * target.area
 
 
-def visible_length(space: Any, p: Sequence[float], segments: shapely.Geometry, tol: float,
-                   vis: Polygon | None = None) -> float:
+def visible_length(
+    space: Any,
+    p: Sequence[float],
+    segments: shapely.Geometry,
+    tol: float,
+    vis: Polygon | None = None,
+) -> float:
     """Length of the part of ``segments`` (lines on occluder boundaries) inside V(p).
 
     V(p) is grown by ``tol`` first, since the segments lie on its boundary.
@@ -162,7 +169,9 @@ def minkowski_sum(a: Polygon, b: Polygon | Point) -> shapely.Geometry:
     parts = []
     for ta in _triangles(a):
         for tb in _triangles(b):
-            parts.append(shapely.MultiPoint((ta[:, None, :] + tb[None, :, :]).reshape(-1, 2)).convex_hull)
+            parts.append(
+                shapely.MultiPoint((ta[:, None, :] + tb[None, :, :]).reshape(-1, 2)).convex_hull
+            )
     return shapely.union_all(parts)
 
 
@@ -170,7 +179,9 @@ def _ccw_coords(poly: Polygon) -> np.ndarray:
     return np.asarray(shapely.orient_polygons(poly, exterior_cw=False).exterior.coords)[:-1]
 
 
-def overlap_segments(a_g: Polygon, a_h: Polygon, tol: float = 1e-9) -> list[tuple[np.ndarray, np.ndarray, int]]:
+def overlap_segments(
+    a_g: Polygon, a_h: Polygon, tol: float = 1e-9
+) -> list[tuple[np.ndarray, np.ndarray, int]]:
     """Overlap segments of A at G with A at H (paper 5.1, point-sized G and H).
 
     Pairs of edges (counter-clockwise, so same direction = same outward normal)
@@ -210,7 +221,9 @@ def non_overlap_segments(a_g: Polygon, a_h: Polygon, tol: float = 1e-9) -> Multi
         d = p1 - p0
         L = float(np.hypot(*d))
         u = d / L
-        cuts = sorted((float(np.dot(s - p0, u)), float(np.dot(e - p0, u))) for s, e, k in ov if k == i)
+        cuts = sorted(
+            (float(np.dot(s - p0, u)), float(np.dot(e - p0, u))) for s, e, k in ov if k == i
+        )
         t = 0.0
         for lo, hi in cuts:
             if lo > t + tol:

@@ -110,7 +110,10 @@ def test_rotating_target_uses_disc_tangents():
 
 def test_partial_sees_through_a_gap():
     # a wall with a narrow gap between the target and the top of the room
-    wall = [[[-10, 3], [-0.2, 3], [-0.2, 3.5], [-10, 3.5]], [[0.2, 3], [10, 3], [10, 3.5], [0.2, 3.5]]]
+    wall = [
+        [[-10, 3], [-0.2, 3], [-0.2, 3.5], [-10, 3.5]],
+        [[0.2, 3], [10, 3], [10, 3.5], [0.2, 3.5]],
+    ]
     sc = scene(obstacles=wall)
     part = partial_region(sc, target_at=(0, 0, 0))
     full = complete_region(sc, target_at=(0, 0, 0))
@@ -125,7 +128,10 @@ def test_partial_sees_through_a_gap():
 
 
 def test_eps_aim_drops_narrow_fans():
-    wall = [[[-10, 3], [-0.05, 3], [-0.05, 3.5], [-10, 3.5]], [[0.05, 3], [10, 3], [10, 3.5], [0.05, 3.5]]]
+    wall = [
+        [[-10, 3], [-0.05, 3], [-0.05, 3.5], [-10, 3.5]],
+        [[0.05, 3], [10, 3], [10, 3.5], [0.05, 3.5]],
+    ]
     sc = scene(obstacles=wall)
     wide = partial_region(sc, target_at=(0, 0, 0))
     narrow = partial_region(sc, target_at=(0, 0, 0), eps_aim=0.2)
@@ -156,7 +162,10 @@ def test_overlap_segments_and_partial_recognition():
     both = sc.target_at(0, 0, 0).union(sc.target_at(1.2, 0, 0))
     assert r.symmetric_difference(sc.free_space.difference(both)).area < 1e-9
     # through a slit above the overlap only overlapping top edges are seen
-    slit = [[[-10, 2], [0.5, 2], [0.5, 2.5], [-10, 2.5]], [[0.7, 2], [10, 2], [10, 2.5], [0.7, 2.5]]]
+    slit = [
+        [[-10, 2], [0.5, 2], [0.5, 2.5], [-10, 2.5]],
+        [[0.7, 2], [10, 2], [10, 2.5], [0.7, 2.5]],
+    ]
     sc2 = scene(target=rect, goal=[[0, 0]], failure=[[1.2, 0]], obstacles=slit)
     r2 = recognizable_region(sc2, model="partial")
     assert inside(partial_region(sc2, target_at=(0, 0, 0)), 0.6, 8)
@@ -169,7 +178,12 @@ def test_overlap_segments_and_partial_recognition():
 
 def test_separated_rooms_give_an_empty_answer():
     wall = [[[-10, -0.5], [10, -0.5], [10, 0.5], [-10, 0.5]]]
-    sc = scene(obstacles=wall, target=[[-0.3, -0.3], [0.3, -0.3], [0.3, 0.3], [-0.3, 0.3]], goal=[[0, 3]], failure=[[0, -3]])
+    sc = scene(
+        obstacles=wall,
+        target=[[-0.3, -0.3], [0.3, -0.3], [0.3, 0.3], [-0.3, 0.3]],
+        goal=[[0, 3]],
+        failure=[[0, -3]],
+    )
     for model in ("complete", "partial"):
         r = recognizable_region(sc, model=model)
         assert r.is_empty and r.geom_type in ("Polygon", "MultiPolygon")
@@ -208,8 +222,10 @@ def test_bad_arguments_fail_clearly():
 
 
 def test_obstacle_in_hull_for_a_query_is_a_scene_error():
-    sc = scene(obstacles=[[[1.6, -0.2], [2.5, -0.2], [2.5, 0.2], [1.6, 0.2]]],
-               target=[[-0.5, -0.2], [1.5, -0.2], [1.5, 0.2], [-0.5, 0.2]])
+    sc = scene(
+        obstacles=[[[1.6, -0.2], [2.5, -0.2], [2.5, 0.2], [1.6, 0.2]]],
+        target=[[-0.5, -0.2], [1.5, -0.2], [1.5, 0.2], [-0.5, 0.2]],
+    )
     complete_region(sc, target_at=(0, 0, 0))
     with pytest.raises(SceneError, match="assumption"):
         complete_region(sc, target_at=(0.5, 0, 0))
@@ -222,5 +238,7 @@ def test_visibility_polygon_of_a_point_in_a_room_with_a_pillar():
     # the pillar hides the part of the room behind it: a trapezoid from the
     # pillar's back face to the far wall, between the rays through (1.5, 1.5)
     # and (1.5, 2.5) -> at x = 4 they are at y = 2 -/+ 3.5 * 0.5 / 1.0
-    hidden = shapely.Polygon([(1.5, 1.5), (4, 0.25), (4, 3.75), (1.5, 2.5)]).difference(shapely.box(1.5, 1.5, 2.5, 2.5))
+    hidden = shapely.Polygon([(1.5, 1.5), (4, 0.25), (4, 3.75), (1.5, 2.5)]).difference(
+        shapely.box(1.5, 1.5, 2.5, 2.5)
+    )
     assert abs(v.area - (free.area - hidden.area)) < 1e-9

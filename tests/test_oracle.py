@@ -47,8 +47,9 @@ def test_oracle_succeeds_on_random_scenes(env_id):
 
 
 def test_oracle_with_uncertainty_noise_and_narrow_view():
-    env = gym.make("sensorplan/Recognize-v0", scene="lab", fov_deg=90, eps_pos=0.05,
-                   eps_aim=0.05, noise=0.01)
+    env = gym.make(
+        "sensorplan/Recognize-v0", scene="lab", fov_deg=90, eps_pos=0.05, eps_aim=0.05, noise=0.01
+    )
     policy = OraclePolicy(env)
     assert all(rollout(env, policy, s)["is_success"] for s in range(4))
 
@@ -84,8 +85,12 @@ def test_one_step_motion_to_nearest_point():
 
 def test_no_placement_exists_is_an_answer():
     # a wall splits the room: G on one side, H on the other, nothing sees both
-    d = {**ROOM, "obstacles": [[[0, 4.8], [10, 4.8], [10, 5.2], [0, 5.2]]],
-         "goal": [[5, 2]], "failure": [[5, 8]]}
+    d = {
+        **ROOM,
+        "obstacles": [[[0, 4.8], [10, 4.8], [10, 5.2], [0, 5.2]]],
+        "goal": [[5, 2]],
+        "failure": [[5, 8]],
+    }
     w = world(d)
     assert w.region.is_empty
     plan = plan_viewpoint(w, (1, 1))
@@ -114,8 +119,15 @@ def test_only_reachable_around_a_corner():
 
 def test_unreachable_region_is_reported():
     # the robot is locked in a closet
-    d = {**ROOM, "obstacles": [[[6, 6], [10, 6], [10, 6.4], [6, 6.4]], [[6, 6], [6.4, 6], [6.4, 10], [6, 10]]],
-         "goal": [[2, 2]], "failure": [[4, 2]]}
+    d = {
+        **ROOM,
+        "obstacles": [
+            [[6, 6], [10, 6], [10, 6.4], [6, 6.4]],
+            [[6, 6], [6.4, 6], [6.4, 10], [6, 10]],
+        ],
+        "goal": [[2, 2]],
+        "failure": [[4, 2]],
+    }
     w = world(d)
     plan = plan_viewpoint(w, (8, 8))
     assert plan.status in ("unreachable", "no_placement")

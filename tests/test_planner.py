@@ -284,8 +284,10 @@ def test_best_aim_symmetric():
 
 
 def test_best_aim_bisects_extent_not_centroid():
-    pts = [(math.cos(math.radians(a)) * r, math.sin(math.radians(a)) * r)
-           for a, r in [(10, 1.0), (50, 5.0), (30, 3.0), (10, 6.0)]]
+    pts = [
+        (math.cos(math.radians(a)) * r, math.sin(math.radians(a)) * r)
+        for a, r in [(10, 1.0), (50, 5.0), (30, 3.0), (10, 6.0)]
+    ]
     psi, margin = best_aim((0, 0), pts, math.radians(90))
     assert math.degrees(psi) == pytest.approx(30.0, abs=1e-9)
     assert math.degrees(margin) == pytest.approx(45 - 20, abs=1e-9)
@@ -317,8 +319,14 @@ def test_best_aim_impossible_and_360():
 
 def test_choose_placement_aims(open_room):
     hull = open_room.swept_hull("goal")
-    pl = choose_placement(open_room, box(6, 4, 8, 6), (1, 5), aim_at=hull,
-                          fov=math.radians(60), eps_aim=math.radians(2))
+    pl = choose_placement(
+        open_room,
+        box(6, 4, 8, 6),
+        (1, 5),
+        aim_at=hull,
+        fov=math.radians(60),
+        eps_aim=math.radians(2),
+    )
     psi, margin = best_aim(pl.point, hull, math.radians(60), math.radians(2))
     assert pl.aim == pytest.approx(psi) and pl.aim_margin == pytest.approx(margin)
     assert margin > 0

@@ -26,8 +26,9 @@ from geometry import Scene, complete_region, partial_region, recognizable_region
 from geometry.generate import random_scene
 
 AREA_TOL = 1e-9
-SETTINGS = settings(max_examples=12, deadline=None, derandomize=True,
-                    suppress_health_check=[HealthCheck.too_slow])
+SETTINGS = settings(
+    max_examples=12, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow]
+)
 
 seeds = st.integers(min_value=0, max_value=2**31 - 1)
 kinds = st.sampled_from(["point", "polygon"])
@@ -57,7 +58,8 @@ def _assert_within(small, big, scene: Scene, what: str) -> None:
 
 def _polygonal(g) -> bool:
     return g.geom_type in ("Polygon", "MultiPolygon", "GeometryCollection") and (
-        g.is_empty or g.geom_type != "GeometryCollection")
+        g.is_empty or g.geom_type != "GeometryCollection"
+    )
 
 
 @SETTINGS
@@ -72,8 +74,7 @@ def test_complete_within_partial(seed, kind, theta):
 
 
 @SETTINGS
-@given(seed=seeds, kind=kinds, theta=angles,
-       e1=st.floats(0.0, 0.05), e2=st.floats(0.0, 0.05))
+@given(seed=seeds, kind=kinds, theta=angles, e1=st.floats(0.0, 0.05), e2=st.floats(0.0, 0.05))
 def test_eps_pos_shrinks_monotonically(seed, kind, theta, e1, e2):
     sc = _scene(seed, kind)
     pose = _pose_in_goal(sc, seed, theta)
@@ -90,8 +91,7 @@ def test_eps_pos_shrinks_monotonically(seed, kind, theta, e1, e2):
 
 
 @SETTINGS
-@given(seed=seeds, kind=kinds, theta=angles,
-       a1=st.floats(0.0, 0.6), a2=st.floats(0.0, 0.6))
+@given(seed=seeds, kind=kinds, theta=angles, a1=st.floats(0.0, 0.6), a2=st.floats(0.0, 0.6))
 def test_eps_aim_shrinks_monotonically(seed, kind, theta, a1, a2):
     sc = _scene(seed, kind)
     pose = _pose_in_goal(sc, seed, theta)
@@ -108,8 +108,10 @@ def _with_extra_obstacle(d: dict, seed: int) -> dict | None:
     sc = Scene.from_dict(d)
     rng = np.random.default_rng(seed)
     r = sc.target_radius
-    keep_out = shapely.union(shapely.convex_hull(sc.goal_geom).buffer(r * 1.05),
-                             shapely.convex_hull(sc.failure_geom).buffer(r * 1.05))
+    keep_out = shapely.union(
+        shapely.convex_hull(sc.goal_geom).buffer(r * 1.05),
+        shapely.convex_hull(sc.failure_geom).buffer(r * 1.05),
+    )
     inner = sc.bounds_geom.buffer(-0.01)
     x0, y0, x1, y1 = sc.bounds_geom.bounds
     for _ in range(200):
@@ -146,8 +148,9 @@ def test_adding_an_obstacle_never_grows_a_region(seed, kind, theta):
         ("recognizable complete", lambda s: recognizable_region(s, model="complete", theta=theta)),
     ]
     if kind == "point":
-        pairs.append(("recognizable partial",
-                      lambda s: recognizable_region(s, model="partial", theta=theta)))
+        pairs.append(
+            ("recognizable partial", lambda s: recognizable_region(s, model="partial", theta=theta))
+        )
     for what, fn in pairs:
         _assert_within(fn(sc2), fn(sc), sc, what)
 

@@ -183,8 +183,9 @@ def test_unknown_orientation_is_searched(scene):
 
 def test_explicit_geometries_without_scene(scene):
     readings, static = scan(scene, (7, 7, 0))
-    dec = classify(readings, static, target=Polygon(TARGET), goal=Point(3, 7),
-                   failure=Point(7, 7), tau=0.05)
+    dec = classify(
+        readings, static, target=Polygon(TARGET), goal=Point(3, 7), failure=Point(7, 7), tau=0.05
+    )
     assert dec.label == "H" and dec.tau == 0.05
     with pytest.raises(ValueError):
         classify(readings, static)

@@ -46,6 +46,7 @@ from shapely.geometry import Point, Polygon  # noqa: E402
 
 from geometry import Scene, complete_region, partial_region, recognizable_region  # noqa: E402
 from geometry.generate import random_scene  # noqa: E402
+
 try:  # rootdir on sys.path (python -m pytest) or tests/ itself (plain pytest)
     from tests.oracle import (  # noqa: E402
         VisOracle,
@@ -130,7 +131,7 @@ def _sample_free(scene: Scene, rng: np.random.Generator, n: int) -> np.ndarray:
     return np.asarray(out[:n])
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def scene_data(seed: int, n_points: int) -> SceneData:
     d = _scene_dict(seed)
     scene = Scene.from_dict(d)
@@ -213,7 +214,7 @@ def _q_complete_translating(sd: SceneData):
     regions = [("custom polygon", _custom_region(sd))]
     if sd.scene.goal_geom.geom_type == "Polygon":
         regions.append(("goal", "goal"))
-    for label, which in regions:
+    for _label, which in regions:
         x = sd.scene.region(which)
         swept = minkowski_sum(a0, x)
         region = complete_region(sd.scene, target_in=which, theta=sd.theta)
@@ -255,14 +256,20 @@ def _q_recognizable_complete(sd: SceneData):
         a0 = sc.target_at(0.0, 0.0, theta)
         sg, sh = minkowski_sum(a0, g), minkowski_sum(a0, h)
         region = recognizable_region(sc, model="complete", theta=theta)
-        tag = "recognizable complete (point G/H)" if g.geom_type == "Point" else \
-            "recognizable complete (polygon G/H)"
+        tag = (
+            "recognizable complete (point G/H)"
+            if g.geom_type == "Point"
+            else "recognizable complete (polygon G/H)"
+        )
 
         def exp(i, p, v, sg=sg, sh=sh):
             pt = Point(p)
-            return (not sg.covers(pt) and not sh.covers(pt)
-                    and sees_completely(sd.oracle, p, sg, vis=v)
-                    and sees_completely(sd.oracle, p, sh, vis=v))
+            return (
+                not sg.covers(pt)
+                and not sh.covers(pt)
+                and sees_completely(sd.oracle, p, sg, vis=v)
+                and sees_completely(sd.oracle, p, sh, vis=v)
+            )
 
         yield region, exp, tag
     if g.geom_type == "Polygon":
@@ -272,9 +279,12 @@ def _q_recognizable_complete(sd: SceneData):
 
         def exp_rot(i, p, v):
             pt = Point(p)
-            return (g.distance(pt) > r and h.distance(pt) > r
-                    and sees_completely(sd.oracle, p, mg, vis=v)
-                    and sees_completely(sd.oracle, p, mh, vis=v))
+            return (
+                g.distance(pt) > r
+                and h.distance(pt) > r
+                and sees_completely(sd.oracle, p, mg, vis=v)
+                and sees_completely(sd.oracle, p, mh, vis=v)
+            )
 
         yield region, exp_rot, "recognizable complete (polygon G/H, any orientation)"
 
@@ -297,22 +307,35 @@ def _q_recognizable_partial(sd: SceneData):
         pt = Point(p)
         if a_g.covers(pt) or a_h.covers(pt):
             return False
-        return (visible_length(og, p, seg_g, tol) > min_len
-                and visible_length(oh, p, seg_h, tol) > min_len)
+        return (
+            visible_length(og, p, seg_g, tol) > min_len
+            and visible_length(oh, p, seg_h, tol) > min_len
+        )
 
     yield region, exp, "recognizable partial (point G/H)"
 
 
 def _all_queries(sd: SceneData):
-    for q in (_q_complete_stationary, _q_complete_translating, _q_complete_rotating,
-              _q_partial_stationary, _q_recognizable_complete, _q_recognizable_partial):
+    for q in (
+        _q_complete_stationary,
+        _q_complete_translating,
+        _q_complete_rotating,
+        _q_partial_stationary,
+        _q_recognizable_complete,
+        _q_recognizable_partial,
+    ):
         yield from q(sd)
 
 
-# -- eps_pos / eps_aim ------------------------------------------------------------------------------
+# -- eps_pos / eps_aim ------------------------------------------------------------
 
-_DISC = np.array([(math.cos(t), math.sin(t)) for t in np.linspace(0, 2 * math.pi, 12, endpoint=False)]
-                 + [(0.5 * math.cos(t), 0.5 * math.sin(t)) for t in np.linspace(0, 2 * math.pi, 6, endpoint=False)])
+_DISC = np.array(
+    [(math.cos(t), math.sin(t)) for t in np.linspace(0, 2 * math.pi, 12, endpoint=False)]
+    + [
+        (0.5 * math.cos(t), 0.5 * math.sin(t))
+        for t in np.linspace(0, 2 * math.pi, 6, endpoint=False)
+    ]
+)
 
 
 def _eps_check(sd: SceneData, tally: Tally, kind: str, n: int) -> None:
@@ -357,8 +380,11 @@ def _eps_check(sd: SceneData, tally: Tally, kind: str, n: int) -> None:
                 # candidates: an interior point of every piece of the implementation's shadows
                 # within the disc (the oracle must confirm it), then points of the disc itself
                 near = shapely.intersection(shadows, Point(p).buffer(0.999 * eps, quad_segs=32))
-                cands = [np.asarray(g.point_on_surface().coords[0]) for g in shapely.get_parts(near)
-                         if g.geom_type == "Polygon" and not g.is_empty]
+                cands = [
+                    np.asarray(g.point_on_surface().coords[0])
+                    for g in shapely.get_parts(near)
+                    if g.geom_type == "Polygon" and not g.is_empty
+                ]
                 cands += [p + 0.999 * eps * u for u in _DISC]
                 for x in cands:
                     if ok_placement(x) and not sees(x):
@@ -378,8 +404,13 @@ def _aim_check(sd: SceneData, tally: Tally) -> None:
         inside, near = _membership(region, sd.pts, sc.diameter)
         for i, p in enumerate(sd.pts):
             if inside[i] and not near[i]:
-                tally.add(sd.seed, p, sees_partially(sd.oracle, p, a, vis=sd.vis[i]), True,
-                          note=f"eps_aim={eps_aim:g} pose={pose}")
+                tally.add(
+                    sd.seed,
+                    p,
+                    sees_partially(sd.oracle, p, a, vis=sd.vis[i]),
+                    True,
+                    note=f"eps_aim={eps_aim:g} pose={pose}",
+                )
 
 
 # -- tests ----------------------------------------------------------------------------------------
@@ -388,9 +419,14 @@ def _aim_check(sd: SceneData, tally: Tally) -> None:
 def _check_regions(seeds, n_points):
     tallies = _run(seeds, n_points, _all_queries)
     expected_tags = {
-        "complete stationary", "complete translating", "complete rotating", "partial stationary",
-        "recognizable complete (point G/H)", "recognizable complete (polygon G/H)",
-        "recognizable complete (polygon G/H, any orientation)", "recognizable partial (point G/H)",
+        "complete stationary",
+        "complete translating",
+        "complete rotating",
+        "partial stationary",
+        "recognizable complete (point G/H)",
+        "recognizable complete (polygon G/H)",
+        "recognizable complete (polygon G/H, any orientation)",
+        "recognizable partial (point G/H)",
     }
     assert expected_tags <= set(tallies)
     failures = []
@@ -431,8 +467,10 @@ def test_eps_regions_agree_with_oracle():
 
 
 @pytest.mark.slow
-@pytest.mark.skipif(not os.environ.get("SENSORPLAN_SLOW"),
-                    reason="minutes long: set SENSORPLAN_SLOW=1 (and use -m slow) to run")
+@pytest.mark.skipif(
+    not os.environ.get("SENSORPLAN_SLOW"),
+    reason="minutes long: set SENSORPLAN_SLOW=1 (and use -m slow) to run",
+)
 def test_regions_agree_with_oracle_many_scenes():
     seeds = range(N_SCENES, N_SCENES + SLOW_SCENES)
     _check_regions(seeds, SLOW_POINTS)
@@ -453,9 +491,12 @@ if __name__ == "__main__":  # agreement report: python -m tests.test_regions_ora
         for kind in ("complete", "partial"):
             _eps_check(sd, all_t.setdefault(f"{kind} eps_pos", Tally()), kind, N_EPS_POINTS)
         _aim_check(sd, all_t.setdefault("partial eps_aim (soundness)", Tally()))
-    print(f"| query type | placements | inside | skipped | agreement |\n|---|---|---|---|---|")
+    print("| query type | placements | inside | skipped | agreement |\n|---|---|---|---|---|")
     for tag, t in sorted(all_t.items()):
-        print(f"| {tag} | {t.total} | {t.inside} | {t.skipped} | {100 * t.agree / max(t.total, 1):.3f} % |")
+        print(
+            f"| {tag} | {t.total} | {t.inside} | {t.skipped} | "
+            f"{100 * t.agree / max(t.total, 1):.3f} % |"
+        )
         for b in t.bad:
             print("    disagreement (seed, p, oracle, region, note):", b)
     print(f"({time.perf_counter() - t0:.1f} s)")

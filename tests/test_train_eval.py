@@ -41,9 +41,21 @@ def tiny_run(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("train")
     cfg = tmp / "tiny.yaml"
     cfg.write_text(yaml.safe_dump({NAV: TINY_PPO}))
-    rec = train(NAV, "ppo", timesteps=256, seed=3, n_envs=2, config=cfg, out=tmp / "run",
-                eval_freq=128, eval_episodes=1, vec_env="dummy", progress_bar=False,
-                tensorboard=False, verbose=0)
+    rec = train(
+        NAV,
+        "ppo",
+        timesteps=256,
+        seed=3,
+        n_envs=2,
+        config=cfg,
+        out=tmp / "run",
+        eval_freq=128,
+        eval_episodes=1,
+        vec_env="dummy",
+        progress_bar=False,
+        tensorboard=False,
+        verbose=0,
+    )
     return rec
 
 
@@ -99,10 +111,29 @@ def test_random_policy_batches_and_is_seeded():
 
 def test_dqn_on_box_env_fails_clearly(tmp_path, capsys):
     with pytest.raises(ValueError, match=r"DQN needs a Discrete action space.*Box"):
-        train(NAV, "dqn", timesteps=10, out=tmp_path / "dqn", progress_bar=False,
-              tensorboard=False, verbose=0)
-    rc = main(["train", "--env", NAV, "--algo", "dqn", "--timesteps", "10",
-               "--out", str(tmp_path / "dqn2"), "--no-progress"])
+        train(
+            NAV,
+            "dqn",
+            timesteps=10,
+            out=tmp_path / "dqn",
+            progress_bar=False,
+            tensorboard=False,
+            verbose=0,
+        )
+    rc = main(
+        [
+            "train",
+            "--env",
+            NAV,
+            "--algo",
+            "dqn",
+            "--timesteps",
+            "10",
+            "--out",
+            str(tmp_path / "dqn2"),
+            "--no-progress",
+        ]
+    )
     assert rc == 2
     err = capsys.readouterr().err
     assert "DQN needs a Discrete action space" in err and "Box" in err
@@ -121,12 +152,42 @@ def test_configs_cover_every_env():
 
 def test_cli_parses():
     p = build_parser()
-    a = p.parse_args(["train", "--env", NAV, "--algo", "sac", "--timesteps", "1000", "--seed",
-                      "2", "--n-envs", "2", "--env-kwargs", '{"scene": "edr"}', "--out", "x"])
+    a = p.parse_args(
+        [
+            "train",
+            "--env",
+            NAV,
+            "--algo",
+            "sac",
+            "--timesteps",
+            "1000",
+            "--seed",
+            "2",
+            "--n-envs",
+            "2",
+            "--env-kwargs",
+            '{"scene": "edr"}',
+            "--out",
+            "x",
+        ]
+    )
     assert (a.command, a.algo, a.timesteps, a.seed, a.n_envs) == ("train", "sac", 1000, 2, 2)
     assert a.env_kwargs == {"scene": "edr"}
-    a = p.parse_args(["evaluate", "--env", NAV, "--policies", "oracle", "random", "m.zip",
-                      "--episodes", "7", "--seed", "1"])
+    a = p.parse_args(
+        [
+            "evaluate",
+            "--env",
+            NAV,
+            "--policies",
+            "oracle",
+            "random",
+            "m.zip",
+            "--episodes",
+            "7",
+            "--seed",
+            "1",
+        ]
+    )
     assert a.policies == ["oracle", "random", "m.zip"] and a.episodes == 7
     with pytest.raises(SystemExit):
         p.parse_args(["train", "--env", NAV, "--algo", "nope"])
@@ -143,8 +204,23 @@ def test_shipped_model_is_small_and_documented():
 
 
 def test_evaluate_random_and_shipped_model(tmp_path, capsys):
-    rc = main(["evaluate", "--env", NAV, "--policies", "random", str(SHIPPED), str(SHIPPED),
-               "--episodes", "3", "--seed", "4", "--out", str(tmp_path)])
+    rc = main(
+        [
+            "evaluate",
+            "--env",
+            NAV,
+            "--policies",
+            "random",
+            str(SHIPPED),
+            str(SHIPPED),
+            "--episodes",
+            "3",
+            "--seed",
+            "4",
+            "--out",
+            str(tmp_path),
+        ]
+    )
     assert rc == 0
     printed = capsys.readouterr().out
     assert "random" in printed and "ppo_navigate_lab" in printed
