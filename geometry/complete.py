@@ -33,12 +33,12 @@ from ._common import (
     shrink_for_position,
     target_spec,
 )
-from ._vis import Domain, visibility_polygon
+from ._vis import visibility_polygon
 
 if TYPE_CHECKING:  # pragma: no cover
     from .scene import Scene
 
-__all__ = ["complete_region", "sees", "tangent_wedges"]
+__all__ = ["complete_region", "tangent_wedges"]
 
 
 def complete_region(
@@ -166,24 +166,3 @@ def _grazes(u: np.ndarray, k: np.ndarray, prev: np.ndarray, nxt: np.ndarray) -> 
     a = d[:, 0] * (prev - u)[:, 1] - d[:, 1] * (prev - u)[:, 0]
     b = d[:, 0] * (nxt - u)[:, 1] - d[:, 1] * (nxt - u)[:, 0]
     return a * b >= 0
-
-
-def sees(dom: Domain, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """For point pairs ``a[i]``, ``b[i]``: True unless a domain segment properly
-    crosses the open segment between them (touching counts as seeing)."""
-    tol = 1e-12 * dom.scale * dom.scale
-    s = dom.seg
-    d = (b - a)[:, None, :]
-    p = s[None, :, :2] - a[:, None, :]
-    q = s[None, :, 2:] - a[:, None, :]
-    o1 = d[..., 0] * p[..., 1] - d[..., 1] * p[..., 0]
-    o2 = d[..., 0] * q[..., 1] - d[..., 1] * q[..., 0]
-    e = (s[:, 2:] - s[:, :2])[None, :, :]
-    r = a[:, None, :] - s[None, :, :2]
-    t = b[:, None, :] - s[None, :, :2]
-    o3 = e[..., 0] * r[..., 1] - e[..., 1] * r[..., 0]
-    o4 = e[..., 0] * t[..., 1] - e[..., 1] * t[..., 0]
-    cross = ((o1 > tol) & (o2 < -tol) | (o1 < -tol) & (o2 > tol)) & (
-        (o3 > tol) & (o4 < -tol) | (o3 < -tol) & (o4 > tol)
-    )
-    return ~cross.any(axis=1)
