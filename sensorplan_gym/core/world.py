@@ -46,7 +46,7 @@ from shapely.geometry import Point
 
 from geometry import Scene, SceneError, recognizable_region
 
-from .sensor import Segments, cast_rays
+from .sensor import Segments
 
 _UNIT = np.array([[1.0, 0.0]])
 
@@ -167,13 +167,20 @@ def sweep(p, d, S: Segments, radius: float, skin: float) -> float:
     dx, dy = float(d[0]), float(d[1])
     if not S.n or (dx == 0.0 and dy == 0.0):
         return 1.0
-    if radius == 0.0:  # a point: one ray of length |d|
-        L = math.hypot(dx, dy)
-        dist, nrm, hit = cast_rays(p[0], p[1], math.atan2(dy, dx), _UNIT, S, L)
-        if not hit[0]:
+    if radius == 0.0:  # a point: one ray p + t d, t in [0, 1], against every segment
+        ax = S.x0 - p[0]
+        ay = S.y0 - p[1]
+        den = dx * S.ey - dy * S.ex
+        par = den == 0.0  # parallel (or collinear): no crossing
+        inv = np.divide(1.0, den, out=np.zeros_like(den), where=~par)
+        t = (ax * S.ey - ay * S.ex) * inv
+        u = (ax * dy - ay * dx) * inv
+        t[par | ~((t >= 0.0) & (u >= 0.0) & (u <= 1.0))] = np.inf
+        i = int(t.argmin())
+        if not t[i] <= 1.0:
             return 1.0
-        rate = abs(float(nrm[0, 0]) * dx + float(nrm[0, 1]) * dy)  # approach speed
-        return max(0.0, float(dist[0]) / L - skin / max(rate, 1e-300))
+        rate = abs(float(S.nx[i]) * dx + float(S.ny[i]) * dy)  # approach speed
+        return max(0.0, float(t[i]) - skin / max(rate, 1e-300))
     ax = p[0] - S.x0
     ay = p[1] - S.y0
     L = np.sqrt(S.L2)
