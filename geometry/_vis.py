@@ -372,9 +372,18 @@ def polygon_from_gaps(g: Gaps) -> shapely.Geometry:
     the viewpoint itself)."""
     if not (g.seg >= 0).any():
         return shapely.Polygon()
+    # consecutive gaps on the same segment continue one straight edge: keep only the
+    # run's first and last points (fewer vertices for the boolean operations downstream)
+    same = (g.seg[1:] == g.seg[:-1]) & (g.seg[1:] >= 0)
+    keep0 = np.concatenate([[True], ~same])
+    keep1 = np.concatenate([~same, [True]])
     pts = np.empty((2 * len(g.p0), 2))
     pts[0::2] = g.p0
     pts[1::2] = g.p1
+    keep = np.empty(2 * len(g.p0), dtype=bool)
+    keep[0::2] = keep0
+    keep[1::2] = keep1
+    pts = pts[keep]
     return clean_polygon(pts, 1e-10 * float(np.abs(pts - g.q).max()))
 
 
