@@ -90,15 +90,23 @@ def _aim_feasible_region(world, region: shapely.Geometry, n: int = 24) -> shapel
 
 
 def plan_viewpoint(
-    world, start_xy: Any, *, keep_out: shapely.Geometry | None = None, margin: float | None = None
+    world,
+    start_xy: Any,
+    *,
+    keep_out: shapely.Geometry | None = None,
+    margin: float | None = None,
+    joint_aim: bool = True,
 ) -> ViewpointPlan:
     """Choose a recognizing pose reachable from ``start_xy`` (paper 6.2-6.3).
 
     ``world`` is an environment's :class:`sensorplan_gym.core.world.World`;
     ``keep_out`` an area the robot must not enter (e.g. where the target may stand);
     ``margin`` the safety margin the region is shrunk by (default 0.2% of the scene
-    diameter).  Never raises for an empty or unreachable region: the result's
-    ``status`` and ``reason`` say what happened.
+    diameter).  With ``joint_aim`` the placement must also admit one aim that keeps both
+    swept targets in the field of view and range (what Placement and Navigate reward);
+    without it any placement of the region will do (a sensor that looks at G and at H in
+    turn).  Never raises for an empty or unreachable region: the result's ``status`` and
+    ``reason`` say what happened.
     """
     start = np.asarray(start_xy, dtype=float)
     margin = 2e-3 * world.diameter if margin is None else float(margin)
@@ -127,7 +135,7 @@ def plan_viewpoint(
         )
 
     plan = attempt(region)
-    if plan.status == "ok" and world.aim_ok(*plan.point, plan.aim):
+    if plan.status == "ok" and (not joint_aim or world.aim_ok(*plan.point, plan.aim)):
         return plan
     feasible = _aim_feasible_region(world, region)
     if feasible.is_empty:
@@ -161,6 +169,7 @@ class _Driver:
         self.looking = False  # arrived at the viewpoint once: now observing
         self.n_classified = -1
         self.decision = None
+        self.looks: list[float] | None = None
 
     # -- planning -----------------------------------------------------------------------
     def _replan(self) -> None:
@@ -172,6 +181,14 @@ class _Driver:
                 *(shapely.convex_hull(shapely.multipoints(k)) for k in w.must_see)
             )
         self.plan = plan_viewpoint(w, (x, y), keep_out=keep_out)
+        self.looks = None
+        if self.plan.status != "ok" and self.env.spec_kind == "recognize":
+            # no single aim sees both: stand anywhere in the region, look at G, then at H
+            self.plan = plan_viewpoint(w, (x, y), keep_out=keep_out, joint_aim=False)
+            if self.plan.status == "ok":
+                p = self.plan.point
+                self.looks = [best_aim(p, k, w.fov, w.eps_aim)[0] for k in w.must_see]
+                self.plan.aim = self.looks[0]
         self.waypoints = [] if self.plan.status != "ok" else [p for p in self.plan.path[1:]]
 
     # -- motion -------------------------------------------------------------------------
@@ -361,13 +378,20 @@ class OraclePolicy:
             drv.observe_target()
             decide = drv.decide(final)
             if decide == 0.0 and drv.looking:
-                # re-aim: sweep by a fraction of the beam spacing around the planned aim
+                # re-aim: sweep the gaps between beams around the planned aim (or around
+                # the aims at G and at H in turn when no single aim sees both): a triangle
+                # wave over one beam spacing, with a step incommensurate with it so that
+                # later passes fall between earlier ones, and never faster than a turn
                 spacing = (
                     2 * math.pi if env.sensor.fov >= 2 * math.pi - 1e-12 else env.sensor.fov
                 ) / max(env.sensor.n_beams, 1)
                 drv.dither += 1
-                offset = spacing * ((drv.dither % 8) / 8.0 - 0.5)
-                a[2] = np.clip(_wrap(drv.plan.aim + offset - env.pose[2]) / env.max_turn, -1, 1)
+                looks = drv.looks or [drv.plan.aim]
+                base = looks[(drv.dither // 16) % len(looks)]
+                step = min(0.1459 * spacing, 0.9 * env.max_turn)
+                phase = (drv.dither * step / spacing) % 2.0
+                offset = spacing * ((phase if phase <= 1.0 else 2.0 - phase) - 0.5)
+                a[2] = np.clip(_wrap(base + offset - env.pose[2]) / env.max_turn, -1, 1)
         return np.array([a[0], a[1], a[2], decide], dtype=np.float32)
 
     def _place(self, env) -> np.ndarray:

@@ -140,3 +140,16 @@ def test_subprocess_vec_env_is_rejected_clearly():
 
     with pytest.raises(TypeError, match="DummyVecEnv"):
         OraclePolicy(Fake())
+
+
+@pytest.mark.parametrize(
+    "kwargs",
+    [
+        {"scene": "lab", "n_beams": 4},  # beams 90 degrees apart: the oracle sweeps between them
+        {"scene": "lab", "n_beams": 4, "fov_deg": 60},  # no aim sees G and H at once: one by one
+    ],
+)
+def test_recognize_oracle_with_sparse_beams_and_narrow_view(kwargs):
+    env = gym.make("sensorplan/Recognize-v0", **kwargs)
+    policy = OraclePolicy(env)
+    assert all(rollout(env, policy, 300 + s)["is_success"] for s in range(6))
