@@ -67,39 +67,31 @@ class Domain:
         return np.stack([a, np.where(w == 0.0, TAU, w)], axis=1)
 
     @staticmethod
-    def from_rings(rings: list[np.ndarray], tags: list[int]) -> Domain:
+    def from_rings(
+        rings: list[np.ndarray], tags: list[int], seg_tags: list[np.ndarray] | None = None
+    ) -> Domain:
         """Build a domain from closed rings (without repeated closing vertex).
 
-        Each ring must already be oriented with the free region on its left.
+        Each ring must already be oriented with the free region on its left; ``tags``
+        gives one tag per ring, ``seg_tags`` optionally one per segment of each ring.
         """
-        segs, sring, stag, verts, prevs, nexts, vring = [], [], [], [], [], [], []
-        for r_i, (ring, tag) in enumerate(zip(rings, tags, strict=False)):
-            ring = np.asarray(ring, dtype=float)
-            nxt = np.roll(ring, -1, axis=0)
-            prv = np.roll(ring, 1, axis=0)
-            segs.append(np.hstack([ring, nxt]))
-            sring.append(np.full(len(ring), r_i))
-            stag.append(np.full(len(ring), tag))
-            verts.append(ring)
-            prevs.append(prv)
-            nexts.append(nxt)
-            vring.append(np.full(len(ring), r_i))
-        vert = np.vstack(verts)
-        vprev = np.vstack(prevs)
-        vnext = np.vstack(nexts)
-        turn = _cross(vert - vprev, vnext - vert)
-        lo = vert.min(axis=0)
-        hi = vert.max(axis=0)
+        rings = [np.asarray(r, dtype=float) for r in rings]
+        nxt = [np.roll(r, -1, axis=0) for r in rings]
+        prv = [np.roll(r, 1, axis=0) for r in rings]
+        ids = [np.full(len(r), i) for i, r in enumerate(rings)]
+        if seg_tags is None:
+            seg_tags = [np.full(len(r), t) for r, t in zip(rings, tags, strict=True)]
+        vert, vprev, vnext = np.vstack(rings), np.vstack(prv), np.vstack(nxt)
         return Domain(
-            seg=np.vstack(segs),
-            seg_ring=np.concatenate(sring),
-            seg_tag=np.concatenate(stag),
+            seg=np.hstack([vert, vnext]),
+            seg_ring=np.concatenate(ids),
+            seg_tag=np.concatenate([np.asarray(t) for t in seg_tags]),
             vert=vert,
             vert_prev=vprev,
             vert_next=vnext,
-            vert_ring=np.concatenate(vring),
-            reflex=turn < 0.0,
-            scale=float(np.hypot(*(hi - lo))),
+            vert_ring=np.concatenate(ids),
+            reflex=_cross(vert - vprev, vnext - vert) < 0.0,
+            scale=float(np.hypot(*(vert.max(axis=0) - vert.min(axis=0)))),
         )
 
     def with_ring(self, ring: np.ndarray, tag: int, tags: np.ndarray | None = None) -> Domain:
@@ -107,21 +99,17 @@ class Domain:
 
         ``tags`` optionally gives a tag per segment of the new ring.
         """
-        ring = np.asarray(ring, dtype=float)
-        nxt = np.roll(ring, -1, axis=0)
-        prv = np.roll(ring, 1, axis=0)
+        extra = Domain.from_rings([ring], [tag], None if tags is None else [tags])
         r_i = int(self.seg_ring.max()) + 1 if len(self.seg_ring) else 0
-        seg_tags = np.full(len(ring), tag) if tags is None else np.asarray(tags)
-        turn = _cross(ring - prv, nxt - ring)
         return Domain(
-            seg=np.vstack([self.seg, np.hstack([ring, nxt])]),
-            seg_ring=np.concatenate([self.seg_ring, np.full(len(ring), r_i)]),
-            seg_tag=np.concatenate([self.seg_tag, seg_tags]),
-            vert=np.vstack([self.vert, ring]),
-            vert_prev=np.vstack([self.vert_prev, prv]),
-            vert_next=np.vstack([self.vert_next, nxt]),
-            vert_ring=np.concatenate([self.vert_ring, np.full(len(ring), r_i)]),
-            reflex=np.concatenate([self.reflex, turn < 0.0]),
+            seg=np.vstack([self.seg, extra.seg]),
+            seg_ring=np.concatenate([self.seg_ring, extra.seg_ring + r_i]),
+            seg_tag=np.concatenate([self.seg_tag, extra.seg_tag]),
+            vert=np.vstack([self.vert, extra.vert]),
+            vert_prev=np.vstack([self.vert_prev, extra.vert_prev]),
+            vert_next=np.vstack([self.vert_next, extra.vert_next]),
+            vert_ring=np.concatenate([self.vert_ring, extra.vert_ring + r_i]),
+            reflex=np.concatenate([self.reflex, extra.reflex]),
             scale=self.scale,
         )
 
