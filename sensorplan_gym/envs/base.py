@@ -42,6 +42,7 @@ from typing import Any
 
 import gymnasium as gym
 import numpy as np
+import shapely
 
 from geometry import Scene
 
@@ -310,6 +311,11 @@ class RobotEnv(SensorPlanEnv):
     ``max_turn * turn``.  The translation is swept against walls, obstacles (and the hidden
     target in Recognize): on contact the robot stops there (it never passes through), and
     ``info["collided"]`` is True.  Out-of-range components are clipped to [-1, 1].
+
+    ``random_start=True`` draws every episode's start pose from ``self.np_random``: a
+    uniform free position that does not recognize yet, in a part of the free space from
+    which the recognizable region is reachable, with a uniform heading (default: the
+    scene's ``start``, like TOMMY's fixed start in the paper).
     """
 
     def __init__(
@@ -318,8 +324,12 @@ class RobotEnv(SensorPlanEnv):
         *,
         max_speed: float | None = None,
         max_turn: float = math.pi / 8,
+        random_start: bool = False,
         **kwargs,
     ) -> None:
+        if not isinstance(random_start, bool):
+            raise ValueError(f"random_start must be True or False, got {random_start!r}")
+        self.random_start = random_start
         for name, v in (("max_speed", max_speed), ("max_turn", max_turn)):
             if v is not None and (
                 not isinstance(v, (int, float)) or not math.isfinite(v) or v <= 0
@@ -329,6 +339,25 @@ class RobotEnv(SensorPlanEnv):
         self.max_turn = float(max_turn)
         self._extra_clearance = None  # distance to dynamic segments (Recognize's target)
         super().__init__(scene, **kwargs)
+
+    def _episode_start(self) -> tuple[float, float, float]:
+        """The start pose of a new episode (see ``random_start``)."""
+        if not self.random_start:
+            return self.start
+        w = self.world
+        space = w._cache.get("start_space")
+        if space is None:
+            comps = shapely.get_parts(w.robot_space)
+            space = shapely.union_all(comps[shapely.intersects(comps, w.region)])
+            shapely.prepare(space)
+            w._cache["start_space"] = space
+        rng = self.np_random
+        for _ in range(10_000):
+            x = rng.uniform(w.lo[0], w.hi[0])
+            y = rng.uniform(w.lo[1], w.hi[1])
+            if shapely.contains_xy(space, x, y) and not w.in_region(x, y):
+                return (float(x), float(y), float(rng.uniform(-math.pi, math.pi)))
+        return self.start  # a region covering nearly all of the free space
 
     @property
     def max_speed(self) -> float:

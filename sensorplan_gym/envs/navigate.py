@@ -71,7 +71,7 @@ class NavigateEnv(RobotEnv):
                 raise ValueError(f"options['start'] = {start!r} is not in the robot's free space")
             self.pose = (x, y, psi)
         else:
-            self.pose = self.start
+            self.pose = self._episode_start()
         self._collided = False
         self._success = False
         self._dist = self.world.distance_to_region(self.pose[0], self.pose[1])

@@ -89,7 +89,7 @@ class RecognizeEnv(RobotEnv):
         self._extra_clearance = _FastDistance(segs)
 
     def _reset_episode(self, options: dict) -> None:
-        self.pose = self.start
+        self.pose = self._episode_start()
         self._elapsed = 0
         self._declared = None
         self._collided = False
