@@ -9,7 +9,7 @@ second watch spot H, and a start like TOMMY's from which neither can be watched)
    obstacles when no one-step motion exists);
 3. the oracle drives there in ``Recognize-v0`` (a hidden target stands in G or H),
    reads the simulated range sensor, and declares G or H from the readings;
-4. oracle vs the shipped PPO policy vs random on ``Navigate-v0`` (lab): a table.
+4. oracle vs the shipped PPO policies vs random on ``Navigate-v0`` (lab): a table.
 
 Figures and the evaluation files go to the folder given by ``--out`` (default
 ``sensorplan-demo``); the path is printed.
@@ -26,7 +26,10 @@ import numpy as np
 
 __all__ = ["main"]
 
-PRETRAINED = Path(__file__).parent / "pretrained" / "ppo_navigate_lab.zip"
+PRETRAINED = [
+    Path(__file__).parent / "pretrained" / "ppo_navigate_lab.zip",
+    Path(__file__).parent / "pretrained" / "ppo_navigate_lab_random_start.zip",
+]
 
 
 def _figure_15(scene, region, path: Path) -> None:
@@ -164,11 +167,9 @@ def main(argv: list[str] | None = None) -> int:
     print(f"4. Navigate-v0 (lab), {args.episodes} episodes per policy:")
     from .evaluate import evaluate, format_table
 
-    policies = ["oracle", "random"]
-    if PRETRAINED.exists():
-        policies.append(str(PRETRAINED))
-    else:
-        print(f"   (no shipped policy at {PRETRAINED}; evaluating oracle and random only)")
+    policies = ["oracle", "random"] + [str(p) for p in PRETRAINED if p.exists()]
+    if len(policies) == 2:
+        print("   (no shipped policy found; evaluating oracle and random only)")
     res = evaluate(
         "sensorplan/Navigate-v0",
         policies,

@@ -296,10 +296,19 @@ def evaluate(
             )
             p["normalized_score"] = None if math.isnan(v) else v
 
-    groups: dict[str, list[dict]] = defaultdict(list)
+    # runs of one algorithm trained with the same env kwargs, differing only in the seed
+    by_config: dict[tuple[str, str], list[dict]] = defaultdict(list)
     for p in results["policies"]:
         if p["kind"] == "model":
-            groups[p["algo"]].append(p)
+            kw = json.dumps(p.get("train_env_kwargs") or {}, sort_keys=True)
+            by_config[(p["algo"], kw)].append(p)
+    n_configs = defaultdict(int)
+    for algo, _ in by_config:
+        n_configs[algo] += 1
+    groups = {
+        (algo if n_configs[algo] == 1 else f"{algo} {kw}"): runs
+        for (algo, kw), runs in by_config.items()
+    }
     for algo, runs in groups.items():
         train_seeds = {r.get("train_seed") for r in runs}
         if len(runs) >= 2 and len(train_seeds) == len(runs):
