@@ -321,7 +321,6 @@ class OraclePolicy:
                 raise TypeError(f"OraclePolicy supports the sensorplan envs, got {kind}")
             e.spec_kind = kind.replace("Env", "").lower()
         self.drivers = [_Driver(e) for e in self.envs]
-        self.last_plan: list[ViewpointPlan | None] = [None] * len(self.envs)
 
     def reset(self) -> None:
         """Forget all episode state (called automatically at episode starts)."""
@@ -365,7 +364,6 @@ class OraclePolicy:
             return self._place(env)
         if drv.plan is None:
             drv._replan()
-            self.last_plan[self.drivers.index(drv)] = drv.plan
         a = drv.drive()
         if env.spec_kind == "navigate":
             return a
