@@ -1,0 +1,667 @@
+"""Swept shadows in the partial-visibility model (paper 3.2.2-3.2.3 and 5.2).
+
+A placement p is *blinded* by configuration q when no wanted point of the
+target A_q is visible from p.  For a target translating (fixed orientation)
+through a region G the placements to avoid are the union of the shadows S(q)
+over q in G.  For a target that is star-shaped with respect to its reference
+point it suffices to let q run along the boundary of G (docs/DESIGN.md); the
+overlap-reduced targets of paper 5.2 are handled the same way (checked on
+interior configurations in the tests).
+
+Along one edge q(t) = q0 + t D of G (0 <= t <= 1) the shadow S(t) changes
+continuously.  Every edge of S(t) lies on a line through two *anchor points*:
+environment vertices (fixed), target vertices (moving with q), or the ends of
+the target's wanted pieces (moving along a fixed line, 5.2).  A point of the
+union of the S(t) that is in neither end shadow lies on the boundary of some
+S(t).  A shadow edge on a line that rotates about one fixed anchor, next to a
+fixed line or a reflex shadow corner, sweeps a set that the shadows before and
+after already cover (the union of a rotating half-plane is the union of its two
+end positions).  What the sampled shadows miss is swept by the *free
+vertices* where two moving lines meet at a convex shadow corner: those trace
+lines or conics (the paper's "free shadow vertices tracing lines and conics").
+So the union is
+
+    the exact stationary shadows at sample times t_k  (paper 3.2.1)
+    plus, for every convex corner of two moving lines found in a sample,
+    the area swept by its two edges while the corner exists.
+
+The corner and the far ends of its edges are traced in closed form (line
+intersections at any t); a trace is kept where an exact point test (below)
+confirms that the corner is still a shadow corner, with the end of its life
+located by bisection.  The traces are emitted as polylines fine enough that
+every chord lies within ``tol`` of its arc (conic arcs have no inflection, so
+the sagitta at the parameter midpoint, checked on a doubling grid, bounds it).
+
+Exact point test: the obstacles do not meet K = CH(A (+) G) (the paper's
+assumption, checked by :class:`Scene`), so a ray that enters K reaches
+everything in K behind its entry point.  The directions in which p sees into
+K (its *windows*) do not depend on q; p sees a wanted piece of A_q iff some
+window overlaps a direction in which, ignoring the obstacles, that piece is
+the first thing hit on A_q.
+
+Shadows born and dying between two sample times without ever touching a
+sampled shadow are found by refining the samples where the shadow of the
+eroded target (the part of A common to the whole interval, whose shadow
+contains the union over the interval) has a component the lower bound misses.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import shapely
+
+from ._common import polygonal
+from ._vis import TAU, Domain, gaps_many
+
+__all__ = ["Sweeper"]
+
+#: Segment tags inside visibility domains built here.
+_ENV, _WANTED, _UNWANTED = 0, 1, 2
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+
+
+def _meet(a0: np.ndarray, a1: np.ndarray, b0: np.ndarray, b1: np.ndarray) -> np.ndarray:
+    """Intersection of the lines (a0, a1) and (b0, b1), row by row (NaN if parallel)."""
+    da, db = a1 - a0, b1 - b0
+    den = _cross(da, db)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        s = _cross(b0 - a0, db) / den
+    return a0 + da * s[..., None]
+
+
+@dataclass
+class Sweeper:
+    """Swept shadows of one target (fixed orientation) moving along segments.
+
+    Parameters
+    ----------
+    env : the free space as a visibility domain (no target).
+    free : the free space as a shapely geometry.
+    ring0 : (m, 2) target outline at reference point (0, 0), counter-clockwise.
+    hull : (k, 2) vertices of K = CH(A (+) G), counter-clockwise; obstacle-free.
+    strips : optional, per target edge i, a shapely geometry U_i such that the
+        part of edge i of A_q inside U_i is *not* wanted (paper 5.2:
+        U_i = union of e_j (+) H over the edges j parallel to i with the same
+        outward direction).  ``None``: the whole outline is wanted.
+    eps_aim : aim uncertainty (radians) of the stationary shadows.
+    tol : polyline tolerance for the traced conic arcs (scene units).
+    """
+
+    env: Domain
+    free: shapely.Geometry
+    ring0: np.ndarray
+    hull: np.ndarray
+    strips: list[shapely.Geometry] | None
+    eps_aim: float
+    tol: float
+    n_samples: int = 4
+    max_depth: int = 6
+    bisect_steps: int = 14
+    probes: int = 16
+    _cut_segs: np.ndarray = field(init=False, repr=False)
+    _cut_edge: np.ndarray = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        self.ring0 = np.asarray(self.ring0, dtype=float)
+        self.hull = np.asarray(self.hull, dtype=float)
+        self.n_fixed = len(self.env.vert)
+        self.m = len(self.ring0)
+        self.edge0 = np.roll(self.ring0, -1, axis=0) - self.ring0
+        segs, owner = [np.zeros((0, 4))], [np.zeros(0, dtype=int)]
+        if self.strips is not None:
+            for i, u in enumerate(self.strips):
+                if u is None or u.is_empty:
+                    continue
+                for ring in _rings(u):
+                    c = np.asarray(ring.coords)[:, :2]
+                    segs.append(np.hstack([c[:-1], c[1:]]))
+                    owner.append(np.full(len(c) - 1, i))
+                shapely.prepare(u)
+        self._cut_segs = np.vstack(segs)
+        self._cut_edge = np.concatenate(owner)
+        shapely.prepare(self.free)
+        self._hull_poly = shapely.Polygon(self.hull)
+        shapely.prepare(self._hull_poly)
+        self.h = 1e-7 * self.env.scale
+        self.tol_lab = 1e-8 * self.env.scale
+
+    # ------------------------------------------------------------------ anchors
+    def pos(self, ids: np.ndarray, q: np.ndarray) -> np.ndarray:
+        """Positions of anchor points ``ids`` (n,) at reference points ``q`` (n, 2)."""
+        ids = np.asarray(ids)
+        out = np.empty((len(ids), 2))
+        n, m = self.n_fixed, self.m
+        f = ids < n
+        out[f] = self.env.vert[ids[f]]
+        v = (ids >= n) & (ids < n + m)
+        out[v] = self.ring0[ids[v] - n] + q[v]
+        c = ids >= n + m
+        if c.any():
+            k = ids[c] - n - m
+            i = self._cut_edge[k]
+            s = self._cut_segs[k]
+            c0, c1 = s[:, :2], s[:, 2:]
+            out[c] = _meet(c0, c1, self.ring0[i] + q[c], self.ring0[i] + q[c] + self.edge0[i])
+        return out
+
+    def outline(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Target at ``q``: counter-clockwise ring with the ends of the wanted
+        pieces inserted, wanted flag per edge, anchor id per ring vertex."""
+        n, m = self.n_fixed, self.m
+        ring = self.ring0 + q
+        if self.strips is None:
+            return ring, np.ones(m, dtype=bool), n + np.arange(m)
+        pts, wanted, ids = [], [], []
+        for i in range(m):
+            a, e = ring[i], self.edge0[i]
+            ks = np.flatnonzero(self._cut_edge == i)
+            params = [(0.0, n + i)]
+            if len(ks):
+                s = self._cut_segs[ks]
+                c0, d = s[:, :2], s[:, 2:] - s[:, :2]
+                den = _cross(e[None, :], d)
+                with np.errstate(divide="ignore", invalid="ignore"):
+                    u = _cross(c0 - a, d) / den  # along the edge
+                    w = _cross(c0 - a, e[None, :]) / den  # along the strip segment
+                ok = np.isfinite(u) & (u > 1e-12) & (u < 1 - 1e-12) & (w >= -1e-12) & (w <= 1 + 1e-12)
+                params += [(float(uu), n + m + int(k)) for uu, k in zip(u[ok], ks[ok], strict=True)]
+            params.sort()
+            us = np.array([p for p, _ in params] + [1.0])
+            mids = a + e * (0.5 * (us[:-1] + us[1:]))[:, None]
+            inside = shapely.contains_xy(self.strips[i], mids[:, 0], mids[:, 1])
+            for (u0, aid), ins in zip(params, inside, strict=True):
+                pts.append(a + u0 * e)
+                wanted.append(not ins)
+                ids.append(aid)
+        return np.asarray(pts), np.asarray(wanted), np.asarray(ids)
+
+    # --------------------------------------------------------- stationary shadow
+    def shadow(self, q: np.ndarray) -> tuple[shapely.Geometry, np.ndarray, np.ndarray]:
+        """Exact shadow S(q) (free space minus target minus the partial region),
+        with the anchor table used to label its edges."""
+        from .partial import weak_visibility
+
+        ring, wanted, ids = self.outline(q)
+        area = shapely.Polygon(self.ring0 + q)
+        if not wanted.any():
+            shadow = shapely.difference(self.free, area)
+        else:
+            reg = weak_visibility(
+                self.env, ring[::-1], np.roll(wanted[::-1], -1), self.eps_aim
+            )
+            shadow = shapely.difference(self.free, shapely.union(reg, area))
+        table = np.vstack([self.env.vert, ring])
+        tid = np.concatenate([np.arange(self.n_fixed), ids])
+        return polygonal(shadow), table, tid
+
+    def _edges(self, shadow: shapely.Geometry, table: np.ndarray, tid: np.ndarray) -> list:
+        """Edges of ``shadow`` on moving lines: ``(key_prev, key, key_next)``, each
+        key a pair of anchor ids spanning the line (shadow on the edge's left)."""
+        out = []
+        n = self.n_fixed
+        for ring in _rings(shapely.orient_polygons(shadow, exterior_cw=False)):
+            v = np.asarray(ring.coords)[:-1, :2]
+            if len(v) < 3:
+                continue
+            keys = self._label(v, table, tid)
+            moving = (keys >= n).any(axis=1) & (keys >= 0).all(axis=1)
+            for i in np.flatnonzero(moving):
+                kp, kn = keys[i - 1], keys[(i + 1) % len(v)]
+                if min(kp) < 0 or min(kn) < 0 or set(kp) == set(keys[i]) or set(kn) == set(keys[i]):
+                    continue
+                out.append((tuple(kp), tuple(keys[i]), tuple(kn)))
+        return out
+
+    def _label(self, v: np.ndarray, table: np.ndarray, tid: np.ndarray) -> np.ndarray:
+        """Per edge of the closed ring ``v``: two anchor ids spanning its line, or -1."""
+        d = np.roll(v, -1, axis=0) - v
+        ln = np.hypot(d[:, 0], d[:, 1])
+        dist = np.abs(_cross(d[:, None, :], table[None, :, :] - v[:, None, :])) / np.maximum(
+            ln[:, None], 1e-300
+        )
+        on = dist <= self.tol_lab
+        keys = np.full((len(v), 2), -1, dtype=np.int64)
+        fixed = tid < self.n_fixed
+        for e in range(len(v)):
+            cand = np.flatnonzero(on[e])
+            if len(cand) < 2:
+                continue
+            # two distinct positions; prefer fixed anchors, then moving ones
+            order = cand[np.argsort(~fixed[cand], kind="stable")]
+            a = order[0]
+            far = np.abs(table[order] - table[a]).max(axis=1) > self.tol_lab
+            if not far.any():
+                continue
+            b = order[np.flatnonzero(far)[0]]
+            keys[e] = sorted((int(tid[a]), int(tid[b])))
+        return keys
+
+    # -------------------------------------------------------------- point test
+    def blind(self, p: np.ndarray, q: np.ndarray) -> np.ndarray:
+        """Exact test, row by row: is placement ``p[j]`` blind to every wanted
+        point of the target at reference point ``q[j]``?  (Q,) bool."""
+        p = np.asarray(p, dtype=float).reshape(-1, 2)
+        q = np.asarray(q, dtype=float).reshape(-1, 2)
+        out = np.zeros(len(p), dtype=bool)
+        # from inside K everything in K is in sight: never blind
+        far = ~shapely.contains_xy(self._hull_poly, p[:, 0], p[:, 1])
+        far &= shapely.contains_xy(self.free, p[:, 0], p[:, 1])  # probes off the map: not blind
+        p, q = p[far], q[far]
+        if len(p) == 0:
+            return out
+        try:
+            out[far] = self._blind(p, q)
+        except RuntimeError:  # a probe on the boundary within float noise: one by one
+            idx = np.flatnonzero(far)
+            for j in range(len(p)):
+                try:
+                    out[idx[j]] = self._blind(p[j : j + 1], q[j : j + 1])[0]
+                except RuntimeError:
+                    out[idx[j]] = False
+        return out
+
+    def _blind(self, p: np.ndarray, q: np.ndarray) -> np.ndarray:
+        base = np.arctan2(*(self.hull.mean(axis=0) - p).T[::-1])
+        rel = self.ring0[None, :, :] + (q - p)[:, None, :]
+        ang = (np.arctan2(rel[..., 1], rel[..., 0]) - base[:, None] + np.pi) % TAU - np.pi
+        lo, hi = ang.min(axis=1), ang.max(axis=1)
+        w_lo, w_hi, w_own = self._windows(p, base, np.stack([base + lo, hi - lo], axis=1))
+        t_lo, t_hi, t_own = self._wanted_dirs(p, q, base)
+        return ~_overlaps(w_lo, w_hi, w_own, t_lo, t_hi, t_own, len(p))
+
+    def _windows(self, p: np.ndarray, base: np.ndarray, sectors: np.ndarray) -> tuple:
+        """Directions (relative to ``base``) inside ``sectors`` (start, width) in
+        which each p sees into K."""
+        g, off = gaps_many(self.env, p, sectors=sectors, flat=True)
+        own = np.repeat(np.arange(len(p)), np.diff(off))
+        ok = g.seg >= 0
+        g_lo, g_hi, own, seg = g.lo[ok], g.hi[ok], own[ok], g.seg[ok]
+        sg = self.env.seg[seg]
+        s0, sd = sg[:, :2], sg[:, 2:] - sg[:, :2]
+        pp = p[own]
+        side_p = np.sign(_cross(sd, pp - s0))
+        kv = self.hull
+        side = _cross(sd[:, None, :], kv[None, :, :] - s0[:, None, :]) * side_p[:, None]
+        keep = side > 0
+        nxt = np.roll(np.arange(len(kv)), -1)
+        cross_e = (side > 0) != (side[:, nxt] > 0)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            lam = side / (side - side[:, nxt])
+        xpt = kv[None, :, :] + lam[..., None] * (kv[nxt] - kv)[None, :, :]
+        pts = np.concatenate([np.broadcast_to(kv, xpt.shape), xpt], axis=1)
+        use = np.concatenate([keep, cross_e], axis=1)
+        rel = np.arctan2(pts[..., 1] - pp[:, None, 1], pts[..., 0] - pp[:, None, 0])
+        rel = (rel - base[own][:, None] + np.pi) % TAU - np.pi
+        amin = np.where(use, rel, np.inf).min(axis=1)
+        amax = np.where(use, rel, -np.inf).max(axis=1)
+        r_lo = (g_lo - base[own] + np.pi) % TAU - np.pi
+        r_hi = r_lo + (g_hi - g_lo)
+        los, his, owns = [], [], []
+        for shift in (0.0, -TAU):
+            lo = np.maximum(r_lo + shift, amin)
+            hi = np.minimum(r_hi + shift, amax)
+            k = hi > lo
+            los.append(lo[k])
+            his.append(hi[k])
+            owns.append(own[k])
+        return np.concatenate(los), np.concatenate(his), np.concatenate(owns)
+
+    def _wanted_dirs(self, p: np.ndarray, q: np.ndarray, base: np.ndarray) -> tuple:
+        """Directions (relative to ``base``) in which, ignoring obstacles, the first
+        point of A_q hit from p is wanted."""
+        rel_pts = self.ring0[None, :, :] + (q - p)[:, None, :]
+        ang = np.arctan2(rel_pts[..., 1], rel_pts[..., 0])
+        ang = (ang - base[:, None] + np.pi) % TAU - np.pi
+        if self.strips is None:
+            return ang.min(axis=1), ang.max(axis=1), np.arange(len(p))
+        dom = self._target_domain()
+        g, off = gaps_many(dom, p - q, flat=True)
+        own = np.repeat(np.arange(len(p)), np.diff(off))
+        hit = (g.seg >= 0) & (dom.seg_tag[np.maximum(g.seg, 0)] == _WANTED)
+        los, his, owns = [], [], []
+        m = self.m
+        for i in range(m):
+            # cw ring segment k runs from ring0[m-1-k] to ring0[m-2-k]: ccw edge i = m-2-k
+            sel = hit & (dom.seg_ring[np.maximum(g.seg, 0)] == 1)
+            sel &= ((m - 2 - (g.seg - self._box_segs)) % m) == i
+            if not sel.any():
+                continue
+            j = own[sel]
+            a, e = self.ring0[i], self.edge0[i]
+            ee = e @ e
+            u0 = ((g.p0[sel] - a) @ e) / ee
+            u1 = ((g.p1[sel] - a) @ e) / ee
+            ulo, uhi = np.minimum(u0, u1), np.maximum(u0, u1)
+            cells = self._cells(i, q[j])
+            for c0, c1, ins in cells:
+                lo = np.maximum(ulo, c0)
+                hi = np.minimum(uhi, c1)
+                k = (hi > lo) & ~ins
+                if not k.any():
+                    continue
+                pl = a + lo[k, None] * e - (p - q)[j[k]]
+                ph = a + hi[k, None] * e - (p - q)[j[k]]
+                al = (np.arctan2(pl[:, 1], pl[:, 0]) - base[j[k]] + np.pi) % TAU - np.pi
+                ah = (np.arctan2(ph[:, 1], ph[:, 0]) - base[j[k]] + np.pi) % TAU - np.pi
+                los.append(np.minimum(al, ah))
+                his.append(np.maximum(al, ah))
+                owns.append(j[k])
+        if not los:
+            return np.zeros(0), np.zeros(0), np.zeros(0, dtype=int)
+        return np.concatenate(los), np.concatenate(his), np.concatenate(owns)
+
+    def _cells(self, i: int, q: np.ndarray) -> list:
+        """Edge i of A_q cut by its strip: list of ``(u0, u1, inside)`` arrays over q."""
+        nq = len(q)
+        ks = np.flatnonzero(self._cut_edge == i)
+        a, e = self.ring0[i] + q, self.edge0[i]
+        if len(ks) == 0:
+            return [(np.zeros(nq), np.ones(nq), np.zeros(nq, dtype=bool))]
+        s = self._cut_segs[ks]
+        c0, d = s[:, :2], s[:, 2:] - s[:, :2]
+        den = _cross(e[None, :], d)[None, :]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            u = _cross(c0[None] - a[:, None], d[None]) / den
+            w = _cross(c0[None] - a[:, None], e[None, None, :]) / den
+        ok = np.isfinite(u) & (u > 0) & (u < 1) & (w >= 0) & (w <= 1)
+        us = np.sort(np.where(ok, u, 1.0), axis=1)
+        us = np.hstack([np.zeros((nq, 1)), us, np.ones((nq, 1))])
+        out = []
+        for c in range(us.shape[1] - 1):
+            mid = a + (0.5 * (us[:, c] + us[:, c + 1]))[:, None] * e
+            ins = shapely.contains_xy(self.strips[i], mid[:, 0], mid[:, 1])
+            out.append((us[:, c], us[:, c + 1], ins))
+        return out
+
+    def _target_domain(self) -> Domain:
+        dom = getattr(self, "_dom_a", None)
+        if dom is None:
+            big = 1e3 * self.env.scale
+            box = np.array([[-big, -big], [big, -big], [big, big], [-big, big]])
+            dom = Domain.from_rings([box, self.ring0[::-1]], [_ENV, _WANTED])
+            self._box_segs = 4
+            self._dom_a = dom
+        return dom
+
+
+    # ------------------------------------------------------------------ sweep
+    def along(self, q0: np.ndarray, q1: np.ndarray) -> tuple[list[shapely.Geometry], dict]:
+        """Pieces whose union is the union of the shadows S(q) for q on the
+        segment ``q0 -> q1``, and counters (samples, traced edges, refinements)."""
+        q0, q1 = np.asarray(q0, dtype=float), np.asarray(q1, dtype=float)
+        dq = q1 - q0
+        stats = {"samples": 0, "edges": 0, "refined": 0}
+        frames: dict[float, tuple] = {}
+
+        def frame(t: float) -> tuple:
+            if t not in frames:
+                shadow, table, tid = self.shadow(q0 + t * dq)
+                frames[t] = (shadow, self._edges(shadow, table, tid))
+                stats["samples"] += 1
+            return frames[t]
+
+        ts = [float(t) for t in np.linspace(0.0, 1.0, self.n_samples + 1)]
+        for t in ts:
+            frame(t)
+        if not float(np.hypot(*dq)) > 0:
+            return [frames[0.0][0]], stats
+        ts = self._refine_births(ts, q0, dq, frame, stats)
+        pieces = [frames[t][0] for t in ts]
+        cover: dict[tuple, list] = {}
+        todo = [(a, b, 0) for a, b in zip(ts[:-1], ts[1:], strict=True)]
+        while todo:
+            a, b, depth = todo.pop()
+            known = shapely.union(frame(a)[0], frame(b)[0])
+            for t, toward in ((a, b), (b, a)):
+                edges = self._uncovered(frame(t)[1], t, toward, known, q0, dq)
+                for e in frame(t)[1]:
+                    if e not in edges:  # swept inside the known shadows: nothing to trace
+                        cover.setdefault(e[1], []).append((a, b))
+                quads, ends = self._trace_many(edges, t, toward, q0, dq)
+                stats["edges"] += len(edges)
+                pieces.extend(quads)
+                for e, end in zip(edges, ends, strict=True):
+                    cover.setdefault(e[1], []).append((min(t, end), max(t, end)))
+            gap = self._coverage_gap(frame(a)[1], frame(b)[1], cover, a, b)
+            if gap is not None and depth < self.max_depth:
+                frame(gap)
+                stats["refined"] += 1
+                pieces.append(frames[gap][0])
+                todo += [(a, gap, depth + 1), (gap, b, depth + 1)]
+        return pieces, stats
+
+    def _uncovered(self, edges: list, t: float, toward: float, known, q0, dq) -> list:
+        """The edges whose sweep from t to ``toward`` (assuming it lives that long)
+        is not already inside ``known`` (rotating into their own shadow)."""
+        if not edges:
+            return []
+        tt = np.array([t, toward])
+        ends = [self._ends(e, tt, q0, dq) for e in edges]
+        quads = np.array([[vs[0], vs[1], ve[1], ve[0]] for vs, ve in ends])
+        ok = np.isfinite(quads).all(axis=(1, 2))
+        polys = shapely.polygons(np.where(ok[:, None, None], quads, 0.0))
+        polys = shapely.make_valid(polys)
+        shapely.prepare(known)
+        rest = shapely.area(shapely.difference(polys, known))
+        need = ~ok | (rest > 1e-9 * self.env.scale**2)
+        return [e for e, n_ in zip(edges, need, strict=True) if n_]
+
+    def _coverage_gap(self, ea: list, eb: list, cover: dict, a: float, b: float) -> float | None:
+        """A time in (a, b) where a moving line that carries shadow edges at both
+        a and b has not been traced (an edge configuration born and gone between
+        the samples), or None."""
+        span = b - a
+        for key in {e[1] for e in ea} & {e[1] for e in eb}:
+            iv = sorted((max(lo, a), min(hi, b)) for lo, hi in cover.get(key, []) if hi > a and lo < b)
+            reach = a
+            for lo, hi in iv:
+                if lo > reach + 1e-9 * span:
+                    return 0.5 * (reach + lo)
+                reach = max(reach, hi)
+            if reach < b - 1e-9 * span:
+                return 0.5 * (reach + b)
+        return None
+
+    def _refine_births(self, ts: list, q0, dq, frame, stats) -> list:
+        """Add sample times where the eroded target's shadow has a component that
+        neither neighbouring sample's shadow meets (a shadow born and dying in
+        between); bisect up to ``max_depth`` times."""
+        if self.strips is not None:
+            return ts
+        todo = [(a, b, 0) for a, b in zip(ts[:-1], ts[1:], strict=True)]
+        out = set(ts)
+        while todo:
+            a, b, depth = todo.pop()
+            if depth >= self.max_depth:
+                continue
+            upper = self._eroded_shadow(q0 + a * dq, q0 + b * dq)
+            if upper is None:
+                new = True
+            else:
+                known = shapely.union(frame(a)[0], frame(b)[0])
+                parts = shapely.get_parts(upper)
+                new = bool((~shapely.intersects(parts, known)).any()) if len(parts) else False
+            if new:
+                m = 0.5 * (a + b)
+                frame(m)
+                out.add(m)
+                stats["refined"] += 1
+                todo += [(a, m, depth + 1), (m, b, depth + 1)]
+        return sorted(out)
+
+    def _eroded_shadow(self, qa: np.ndarray, qb: np.ndarray) -> shapely.Geometry | None:
+        """Shadow of the part of A common to all A_q, q in [qa, qb] (it contains
+        every S(q) there); None when that part is empty."""
+        from .partial import weak_visibility
+
+        aa = shapely.Polygon(self.ring0 + qa)
+        ab = shapely.Polygon(self.ring0 + qb)
+        core = shapely.intersection(aa, ab)
+        r = self.ring0 + qa
+        e = np.roll(r, -1, axis=0)
+        d = qb - qa
+        par = shapely.polygons(np.stack([r, e, e + d, r + d], axis=1))
+        core = polygonal(shapely.difference(core, shapely.union_all(par)))
+        if core.is_empty:
+            return None
+        parts = shapely.get_parts(core)
+        core = parts[np.argmax(shapely.area(parts))]
+        ring = np.asarray(shapely.orient_polygons(core, exterior_cw=True).exterior.coords)[:-1]
+        reg = weak_visibility(self.env, ring, np.ones(len(ring), dtype=bool), self.eps_aim)
+        return polygonal(shapely.difference(self.free, shapely.union(reg, core)))
+
+    def _trace_many(self, edges: list, ta: float, tb: float, q0, dq) -> tuple[list, list]:
+        """Areas swept by moving shadow edges found at sample ``ta`` while they live
+        between ``ta`` and ``tb``; returns ``(quads, end time reached per edge)``."""
+        if not edges:
+            return [], []
+        ts = self._grid(edges, ta, tb, q0, dq)
+        vs, ve = self._ends_many(edges, np.broadcast_to(ts, (len(edges), len(ts))), q0, dq)
+        ok = self._valid_many(vs, ve, np.broadcast_to(ts, vs.shape[:2]), q0, dq)
+        n_ok = np.where(ok.all(axis=1), len(ts), np.argmin(ok, axis=1))
+        # bisect the death time of the edges that die inside the interval
+        dying = np.flatnonzero((n_ok > 0) & (n_ok < len(ts)))
+        t_end = np.full(len(edges), float(ts[-1]))
+        if len(dying):
+            t_ok = ts[n_ok[dying] - 1].astype(float)
+            t_bad = ts[n_ok[dying]].astype(float)
+            sub = [edges[i] for i in dying]
+            for _ in range(self.bisect_steps):
+                tm = 0.5 * (t_ok + t_bad)
+                a, b = self._ends_many(sub, tm[:, None], q0, dq)
+                good = self._valid_many(a, b, tm[:, None], q0, dq)[:, 0]
+                t_ok = np.where(good, tm, t_ok)
+                t_bad = np.where(good, t_bad, tm)
+            t_end[dying] = t_ok
+        quads, ends = [], []
+        for i, e in enumerate(edges):
+            k = int(n_ok[i])
+            if k == 0:
+                ends.append(ta)
+                continue
+            tk = ts[:k] if k == len(ts) else np.append(ts[:k], t_end[i])
+            ends.append(float(tk[-1]))
+            if len(tk) < 2:
+                continue
+            a, b = self._ends(e, tk, q0, dq)
+            quads.append(np.stack([a[:-1], a[1:], b[1:], b[:-1]], axis=1))
+        if not quads:
+            return [], ends
+        polys = shapely.polygons(np.concatenate(quads))
+        bad = ~shapely.is_valid(polys)
+        if bad.any():
+            polys[bad] = shapely.make_valid(polys[bad])
+        return list(polys), ends
+
+    def _ends(self, edge, ts: np.ndarray, q0, dq) -> tuple[np.ndarray, np.ndarray]:
+        """Start and end points of one shadow edge at times ``ts``."""
+        a, b = self._ends_many([edge], np.asarray(ts)[None, :], q0, dq)
+        return a[0], b[0]
+
+    def _ends_many(self, edges: list, ts: np.ndarray, q0, dq) -> tuple[np.ndarray, np.ndarray]:
+        """Start and end points of shadow edges (E) at times ``ts`` (E, T) or (1, T)."""
+        k = np.asarray(edges, dtype=np.int64)  # (E, 3, 2)
+        ts = np.broadcast_to(ts, (len(edges), ts.shape[-1]))
+        q = q0 + ts[..., None] * dq  # (E, T, 2)
+        ids = np.broadcast_to(k[:, None, :, :], (len(edges), ts.shape[1], 3, 2))
+        qq = np.broadcast_to(q[:, :, None, None, :], ids.shape + (2,))
+        p = self.pos(ids.reshape(-1), qq.reshape(-1, 2)).reshape(ids.shape + (2,))
+        lp, le, ln_ = p[:, :, 0], p[:, :, 1], p[:, :, 2]
+        return _meet(lp[..., 0, :], lp[..., 1, :], le[..., 0, :], le[..., 1, :]), _meet(
+            le[..., 0, :], le[..., 1, :], ln_[..., 0, :], ln_[..., 1, :]
+        )
+
+    def _grid(self, edges: list, a: float, b: float, q0, dq) -> np.ndarray:
+        """Times from a to b so fine that the traced polylines stay within tol."""
+        n = 9
+        while True:
+            ts = np.linspace(a, b, n)
+            mid = 0.5 * (ts[:-1] + ts[1:])
+            err = 0.0
+            ends = self._ends_many(edges, ts[None, :], q0, dq)
+            mids = self._ends_many(edges, mid[None, :], q0, dq)
+            for c, m in zip(ends, mids, strict=True):
+                chord = c[:, 1:] - c[:, :-1]
+                ln = np.hypot(chord[..., 0], chord[..., 1])
+                with np.errstate(divide="ignore", invalid="ignore"):
+                    dev = np.where(ln > 0, np.abs(_cross(chord, m - c[:, :-1])) / ln, 0.0)
+                dev = dev[np.isfinite(dev)]
+                err = max(err, float(dev.max()) if len(dev) else 0.0)
+            if err <= self.tol or n >= 257:
+                return ts
+            n = 2 * n - 1
+
+    def _valid_many(self, vs: np.ndarray, ve: np.ndarray, ts: np.ndarray, q0, dq) -> np.ndarray:
+        """(E, T) bool: the traced edge is a shadow edge at that time (exact point
+        test on probes just inside the shadow along the edge)."""
+        d = ve - vs
+        ln = np.hypot(d[..., 0], d[..., 1])
+        with np.errstate(divide="ignore", invalid="ignore"):
+            u = d / ln[..., None]
+        h = np.minimum(self.h, 0.05 * ln)[..., None]
+        nrm = _rot(u) * (1e-3 * h)
+        fr = np.arange(1, self.probes) / self.probes
+        probes = [vs + h * u + nrm, ve - h * u + nrm]
+        probes += [vs + f * d + nrm for f in fr]
+        probes = np.stack(probes, axis=-2)  # (E, T, P, 2)
+        q = np.broadcast_to((q0 + ts[..., None] * dq)[..., None, :], probes.shape)
+        flat_p, flat_q = probes.reshape(-1, 2), q.reshape(-1, 2)
+        finite = np.isfinite(flat_p).all(axis=1)
+        res = np.zeros(len(flat_p), dtype=bool)
+        res[finite] = self.blind(flat_p[finite], flat_q[finite])
+        return res.reshape(probes.shape[:-1]).all(axis=-1) & (ln > 0)
+
+
+def _overlaps(a_lo, a_hi, a_own, b_lo, b_hi, b_own, n: int, eps: float = 1e-12) -> np.ndarray:
+    """(n,) bool: does some interval of family a overlap (by more than ``eps``)
+    some interval of family b with the same owner?"""
+    out = np.zeros(n, dtype=bool)
+    if len(a_lo) == 0 or len(b_lo) == 0:
+        return out
+    ia = np.argsort(a_own, kind="stable")
+    ib = np.argsort(b_own, kind="stable")
+    a_lo, a_hi, a_own = a_lo[ia], a_hi[ia], a_own[ia]
+    b_lo, b_hi, b_own = b_lo[ib], b_hi[ib], b_own[ib]
+    ca = np.bincount(a_own, minlength=n)
+    cb = np.bincount(b_own, minlength=n)
+    oa = np.concatenate([[0], np.cumsum(ca)])
+    ob = np.concatenate([[0], np.cumsum(cb)])
+    wa, wb = int(ca.max()), int(cb.max())
+    A_lo = np.full((n, wa), np.nan)
+    A_hi = np.full((n, wa), np.nan)
+    B_lo = np.full((n, wb), np.nan)
+    B_hi = np.full((n, wb), np.nan)
+    ra = np.arange(len(a_lo)) - oa[a_own]
+    rb = np.arange(len(b_lo)) - ob[b_own]
+    A_lo[a_own, ra], A_hi[a_own, ra] = a_lo, a_hi
+    B_lo[b_own, rb], B_hi[b_own, rb] = b_lo, b_hi
+    with np.errstate(invalid="ignore"):
+        ov = np.minimum(A_hi[:, :, None], B_hi[:, None, :]) - np.maximum(
+            A_lo[:, :, None], B_lo[:, None, :]
+        )
+        return (ov > eps).any(axis=(1, 2))
+
+
+def _rings(g: shapely.Geometry) -> list:
+    out = []
+    for poly in shapely.get_parts(g):
+        if poly.geom_type != "Polygon" or poly.is_empty:
+            continue
+        out.append(poly.exterior)
+        out.extend(poly.interiors)
+    return out
+
+
+def _unit(v: np.ndarray) -> np.ndarray:
+    n = np.hypot(v[..., 0], v[..., 1])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return v / n[..., None]
+
+
+def _rot(v: np.ndarray) -> np.ndarray:
+    return np.stack([-v[..., 1], v[..., 0]], axis=-1)
