@@ -26,8 +26,17 @@ from typing import TYPE_CHECKING
 import numpy as np
 import shapely
 
-from ._common import check_eps, polygonal, scene_domain, shrink_for_position, target_spec
+from ._common import (
+    OUTER,
+    QUAD_SEGS,
+    check_eps,
+    polygonal,
+    scene_domain,
+    shrink_for_position,
+    target_spec,
+)
 from ._vis import TAU, Domain, Gaps, clean_polygon, gaps_many
+from .sweep import swept_shadows
 
 if TYPE_CHECKING:  # pragma: no cover
     from .scene import Scene
@@ -37,9 +46,10 @@ __all__ = ["partial_region", "weak_visibility"]
 #: Segment tags inside the visibility domain.
 ENV, WANTED, UNWANTED = 0, 1, 2
 
-SWEEP_TOPIC = (
-    "partial visibility of a target moving through a region (paper 3.2.2-3.2.3, swept shadows; "
-    "issue 'Partial visibility of a translating target and confusability for polygonal G and H')"
+ROTATING_PARTIAL = (
+    "the partial-visibility model for a target of unknown orientation (theta=None) is not "
+    "given by the paper (its conclusion leaves it to future work); use model='complete' "
+    "or a fixed theta"
 )
 
 
@@ -51,29 +61,43 @@ def partial_region(
     theta: float | None = 0.0,
     eps_pos: float = 0.0,
     eps_aim: float = 0.0,
+    tol: float | None = None,
+    conservative: bool = False,
 ) -> shapely.Geometry:
     """Sensor placements from which some point of the target is visible.
 
     Parameters
     ----------
     target_at : ``(x, y, theta)`` of a stationary target (world frame, radians).
-    target_in : a region the target moves through -- not implemented yet: raises
-        ``NotImplementedError`` (swept shadows, paper 3.2.2-3.2.3).
+    target_in : ``"goal"``, ``"failure"`` or a shapely Polygon/Point: the target
+        translates through this region at orientation ``theta`` and the answer is
+        the placements that see some point of it *wherever* it is there (the
+        complement of the swept shadows, paper 3.2.2-3.2.3, :mod:`geometry.sweep`).
+    theta : orientation (radians) of a target given by ``target_in``; ``None``
+        (any orientation) is not supported in the partial model.
     eps_pos : worst-case placement error (scene units): shadows grown by the disc.
     eps_aim : worst-case aim error (radians): visibility polygons whose apex angle
         at their anchor vertex is below ``eps_aim`` are dropped (paper section 4).
+    tol : only with ``target_in``: the shadow boundaries traced by free vertices
+        (lines and conics) are emitted as polylines whose chords stay within
+        ``tol`` (scene units) of the curves; default ``1e-4 * scene.diameter``.
+    conservative : only with ``target_in``: grow the shadows by ``tol`` so that
+        the answer lies inside the exact region (safe for planning).
 
     Returns
     -------
     A shapely Polygon/MultiPolygon (possibly empty) in world coordinates: the
-    placements inside the bounds, outside obstacles and outside the target.
+    placements inside the bounds, outside obstacles and outside the target (for
+    ``target_in``: outside the area the target sweeps).
     """
     eps_pos = check_eps("eps_pos", eps_pos)
     eps_aim = check_eps("eps_aim", eps_aim)
     if target_in is not None:
-        raise NotImplementedError(
-            f"partial_region(target_in=...) is not implemented yet: {SWEEP_TOPIC}"
-        )
+        if target_at is not None:
+            raise ValueError("give exactly one of target_at=(x, y, theta) or target_in=<region>")
+        return _swept_region(scene, target_in, theta, eps_pos, eps_aim, tol, conservative)
+    if tol is not None or conservative:
+        raise ValueError("tol and conservative apply to a moving target (target_in=...) only")
     if target_at is None:
         raise ValueError("give target_at=(x, y, theta)")
     spec = target_spec(scene, target_at, None, theta)
@@ -84,6 +108,55 @@ def partial_region(
         allowed = shapely.difference(scene.free_space, spec.area)
         region = shrink_for_position(region, allowed, eps_pos)
     return region
+
+
+def _swept_region(
+    scene: Scene,
+    target_in: str | shapely.Geometry,
+    theta: float | None,
+    eps_pos: float,
+    eps_aim: float,
+    tol: float | None,
+    conservative: bool,
+    strips: list[shapely.Geometry] | None = None,
+) -> shapely.Geometry:
+    """The partial region of a target translating through ``target_in``."""
+    if theta is None:
+        raise NotImplementedError(ROTATING_PARTIAL)
+    tol = swept_tol(scene, tol)
+    spec = target_spec(scene, None, target_in, float(theta))
+    region = scene.region(target_in) if isinstance(target_in, str) else target_in
+    target = _ccw_ring(scene.target_at(0.0, 0.0, float(theta)))
+    shadows, _ = swept_shadows(
+        scene_domain(scene),
+        scene.free_space,
+        target,
+        region,
+        strips=strips,
+        eps_aim=eps_aim,
+        tol=tol,
+    )
+    if conservative:
+        shadows = shapely.buffer(shadows, tol * OUTER, quad_segs=QUAD_SEGS)
+    allowed = shapely.difference(scene.free_space, spec.area)
+    out = polygonal(shapely.difference(allowed, shadows))
+    if eps_pos > 0:
+        out = shrink_for_position(out, allowed, eps_pos)
+    return out
+
+
+def swept_tol(scene: Scene, tol: float | None) -> float:
+    """Validate ``tol`` (scene units, > 0); ``None`` gives 1e-4 of the scene diameter."""
+    if tol is None:
+        return 1e-4 * scene.diameter
+    t = check_eps("tol", tol)
+    if t <= 0:
+        raise ValueError(f"tol must be > 0, got {tol!r}")
+    return t
+
+
+def _ccw_ring(poly: shapely.Polygon) -> np.ndarray:
+    return np.asarray(shapely.orient_polygons(poly, exterior_cw=False).exterior.coords)[:-1, :2]
 
 
 def _hole_ring(poly: shapely.Polygon) -> np.ndarray:

@@ -26,20 +26,24 @@ from typing import TYPE_CHECKING
 import numpy as np
 import shapely
 
-from ._common import check_eps, polygonal, scene_domain, shrink_for_position, target_spec
+from ._common import (
+    OUTER,
+    QUAD_SEGS,
+    _triangles,
+    check_eps,
+    polygonal,
+    scene_domain,
+    shrink_for_position,
+    target_spec,
+)
 from .complete import complete_region
-from .partial import SWEEP_TOPIC, weak_visibility
+from .partial import ROTATING_PARTIAL, _ccw_ring, swept_tol, weak_visibility
+from .sweep import swept_shadows
 
 if TYPE_CHECKING:  # pragma: no cover
     from .scene import Scene
 
 __all__ = ["overlap_segments", "recognizable_region"]
-
-ROTATING_PARTIAL = (
-    "the partial-visibility model for a target of unknown orientation (theta=None) is not "
-    "given by the paper (its conclusion leaves it to future work); use model='complete' "
-    "or a fixed theta"
-)
 
 
 def recognizable_region(
@@ -49,6 +53,8 @@ def recognizable_region(
     theta: float | None = 0.0,
     eps_pos: float = 0.0,
     eps_aim: float = 0.0,
+    tol: float | None = None,
+    conservative: bool = False,
 ) -> shapely.Geometry:
     """Placements from which "target in G" and "target in H" are told apart.
 
@@ -63,6 +69,11 @@ def recognizable_region(
         visibility polygons are dropped).  In the complete model it does not
         change *where* to stand; the aim itself is checked against the field of
         view by the caller.
+
+    tol, conservative : partial model with polygonal G and H (paper 5.2) only:
+        the polyline tolerance of the swept shadows (default 1e-4 of the scene
+        diameter) and whether to grow the shadows by it so that the answer lies
+        inside the exact region (see :func:`partial_region`).
 
     Returns
     -------
@@ -81,12 +92,16 @@ def recognizable_region(
     if theta is None:
         raise NotImplementedError(ROTATING_PARTIAL)
     g, h = scene.goal_geom, scene.failure_geom
-    if g.geom_type != "Point" or h.geom_type != "Point":
-        raise NotImplementedError(
-            "recognizable_region(model='partial') for polygonal G or H is not implemented yet: "
-            + SWEEP_TOPIC
-        )
     th = float(theta)
+    if g.geom_type != h.geom_type:
+        raise NotImplementedError(
+            "recognizable_region(model='partial') needs G and H of the same kind: both points "
+            "(paper 5.1) or both polygons (paper 5.2); this scene mixes a point and a polygon"
+        )
+    if g.geom_type == "Polygon":
+        return _swept_recognizable(scene, th, eps_pos, eps_aim, swept_tol(scene, tol), conservative)
+    if tol is not None or conservative:
+        raise ValueError("tol and conservative apply to polygonal G and H only")
     regions = []
     for me, other in ((g, h), (h, g)):
         spec = target_spec(scene, (me.x, me.y, th), None, None)
@@ -101,6 +116,56 @@ def recognizable_region(
             reg = shrink_for_position(reg, shapely.difference(scene.free_space, spec.area), eps_pos)
         regions.append(reg)
     return polygonal(shapely.intersection(*regions))
+
+
+def _swept_recognizable(
+    scene: Scene, theta: float, eps_pos: float, eps_aim: float, tol: float, conservative: bool
+) -> shapely.Geometry:
+    """Paper 5.2: the non-overlap part A'(q) of the target swept through G and
+    through H; the two partial regions intersected."""
+    target = _ccw_ring(scene.target_at(0.0, 0.0, theta))
+    regions = []
+    for me, other in (("goal", "failure"), ("failure", "goal")):
+        spec = target_spec(scene, None, me, theta)
+        strips = overlap_strips(target, scene.region(other))
+        shadows, _ = swept_shadows(
+            scene_domain(scene),
+            scene.free_space,
+            target,
+            scene.region(me),
+            strips=strips,
+            eps_aim=eps_aim,
+            tol=tol,
+        )
+        if conservative:
+            shadows = shapely.buffer(shadows, tol * OUTER, quad_segs=QUAD_SEGS)
+        allowed = shapely.difference(scene.free_space, spec.area)
+        reg = polygonal(shapely.difference(allowed, shadows))
+        if eps_pos > 0:
+            reg = shrink_for_position(reg, allowed, eps_pos)
+        regions.append(reg)
+    return polygonal(shapely.intersection(*regions))
+
+
+def overlap_strips(target: np.ndarray, other: shapely.Polygon) -> list[shapely.Geometry]:
+    """Per edge i of ``target`` (counter-clockwise, reference point at the
+    origin): U_i = union of e_j (+) X over the edges j with the same direction,
+    X the *other* region.  A piece of edge i of A_q (q in this region) inside
+    U_i coincides with an edge of A_q' for some q' in X: the overlap O(e_i, e_j)
+    of paper 5.2, which cannot tell the two regions apart."""
+    e = np.roll(target, -1, axis=0) - target
+    u = e / np.hypot(e[:, 0], e[:, 1])[:, None]
+    tri = _triangles(other)
+    out: list[shapely.Geometry] = []
+    for i in range(len(target)):
+        same = np.flatnonzero((u @ u[i]) > 1 - 1e-12)
+        parts = []
+        for j in same:
+            a, b = target[j], target[(j + 1) % len(target)]
+            pts = np.concatenate([tri + a, tri + b], axis=1)  # (T, 6, 2)
+            parts.append(shapely.convex_hull(shapely.multipoints(pts)))
+        out.append(shapely.union_all(np.concatenate(parts)))
+    return out
 
 
 def overlap_segments(scene: Scene, theta: float = 0.0) -> list[shapely.LineString]:

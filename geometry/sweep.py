@@ -51,11 +51,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import shapely
+from shapely import affinity
 
 from ._common import polygonal
 from ._vis import TAU, Domain, gaps_many
 
-__all__ = ["Sweeper"]
+__all__ = ["Sweeper", "star_center", "swept_shadows"]
 
 #: Segment tags inside visibility domains built here.
 _ENV, _WANTED, _UNWANTED = 0, 1, 2
@@ -168,7 +169,13 @@ class Sweeper:
                 with np.errstate(divide="ignore", invalid="ignore"):
                     u = _cross(c0 - a, d) / den  # along the edge
                     w = _cross(c0 - a, e[None, :]) / den  # along the strip segment
-                ok = np.isfinite(u) & (u > 1e-12) & (u < 1 - 1e-12) & (w >= -1e-12) & (w <= 1 + 1e-12)
+                ok = (
+                    np.isfinite(u)
+                    & (u > 1e-12)
+                    & (u < 1 - 1e-12)
+                    & (w >= -1e-12)
+                    & (w <= 1 + 1e-12)
+                )
                 params += [(float(uu), n + m + int(k)) for uu, k in zip(u[ok], ks[ok], strict=True)]
             params.sort()
             us = np.array([p for p, _ in params] + [1.0])
@@ -191,9 +198,7 @@ class Sweeper:
         if not wanted.any():
             shadow = shapely.difference(self.free, area)
         else:
-            reg = weak_visibility(
-                self.env, ring[::-1], np.roll(wanted[::-1], -1), self.eps_aim
-            )
+            reg = weak_visibility(self.env, ring[::-1], np.roll(wanted[::-1], -1), self.eps_aim)
             shadow = shapely.difference(self.free, shapely.union(reg, area))
         table = np.vstack([self.env.vert, ring])
         tid = np.concatenate([np.arange(self.n_fixed), ids])
@@ -292,7 +297,7 @@ class Sweeper:
         cross_e = (side > 0) != (side[:, nxt] > 0)
         with np.errstate(divide="ignore", invalid="ignore"):
             lam = side / (side - side[:, nxt])
-        xpt = kv[None, :, :] + lam[..., None] * (kv[nxt] - kv)[None, :, :]
+            xpt = kv[None, :, :] + lam[..., None] * (kv[nxt] - kv)[None, :, :]
         pts = np.concatenate([np.broadcast_to(kv, xpt.shape), xpt], axis=1)
         use = np.concatenate([keep, cross_e], axis=1)
         rel = np.arctan2(pts[..., 1] - pp[:, None, 1], pts[..., 0] - pp[:, None, 0])
@@ -388,7 +393,6 @@ class Sweeper:
             self._dom_a = dom
         return dom
 
-
     # ------------------------------------------------------------------ sweep
     def along(self, q0: np.ndarray, q1: np.ndarray) -> tuple[list[shapely.Geometry], dict]:
         """Pieces whose union is the union of the shadows S(q) for q on the
@@ -457,7 +461,9 @@ class Sweeper:
         the samples), or None."""
         span = b - a
         for key in {e[1] for e in ea} & {e[1] for e in eb}:
-            iv = sorted((max(lo, a), min(hi, b)) for lo, hi in cover.get(key, []) if hi > a and lo < b)
+            iv = sorted(
+                (max(lo, a), min(hi, b)) for lo, hi in cover.get(key, []) if hi > a and lo < b
+            )
             reach = a
             for lo, hi in iv:
                 if lo > reach + 1e-9 * span:
@@ -665,3 +671,77 @@ def _unit(v: np.ndarray) -> np.ndarray:
 
 def _rot(v: np.ndarray) -> np.ndarray:
     return np.stack([-v[..., 1], v[..., 0]], axis=-1)
+
+
+def star_center(ring: np.ndarray) -> np.ndarray | None:
+    """A point of the kernel of the polygon ``ring`` (counter-clockwise), preferring
+    the origin; None when the polygon is not star-shaped."""
+    e = np.roll(ring, -1, axis=0) - ring
+    if (_cross(ring, np.roll(ring, -1, axis=0)) >= 0).all():
+        return np.zeros(2)
+    big = 4 * float(np.abs(ring).max()) + 1.0
+    ker = shapely.box(-big, -big, big, big)
+    for a, d in zip(ring, e, strict=True):
+        n = _rot(d) / np.hypot(*d)  # inward normal (ccw ring)
+        half = shapely.Polygon(
+            [a - d * big, a + d * big, a + d * big + n * big, a - d * big + n * big]
+        )
+        ker = shapely.intersection(ker, half)
+    if ker.is_empty or ker.area <= 1e-12 * big * big:
+        return None
+    return np.asarray(ker.centroid.coords[0])
+
+
+def swept_shadows(
+    env: Domain,
+    free: shapely.Geometry,
+    target: np.ndarray,
+    region: shapely.Geometry,
+    *,
+    strips: list[shapely.Geometry] | None = None,
+    eps_aim: float = 0.0,
+    tol: float,
+) -> tuple[shapely.Geometry, dict]:
+    """Union of the partial-visibility shadows S(q) over the reference points q
+    of ``region`` (a Point or Polygon), for the target outline ``target``
+    (counter-clockwise, reference point at the origin, fixed orientation).
+
+    The target must be star-shaped; the sweep runs over the boundary of the
+    region with the reference point moved into the target's kernel (the swept
+    set of placements does not depend on that choice).  Returns the union (a
+    shapely geometry, world frame) and counters.
+    """
+    c = star_center(target)
+    if c is None:
+        raise NotImplementedError(
+            "the swept partial region needs a star-shaped target (traversing the boundary "
+            "of the region only suffices then); this target has an empty kernel"
+        )
+    ring0 = target - c
+    region = affinity.translate(region, c[0], c[1])
+    hull = shapely.convex_hull(
+        shapely.multipoints((ring0[:, None, :] + _region_pts(region)[None, :, :]).reshape(-1, 2))
+    )
+    hull_pts = np.asarray(shapely.orient_polygons(hull, exterior_cw=False).exterior.coords)[:-1]
+    sw = Sweeper(env, free, ring0, hull_pts, strips, eps_aim, tol)
+    pieces: list[shapely.Geometry] = []
+    stats = {"samples": 0, "edges": 0, "refined": 0}
+    if region.geom_type == "Point":
+        q = np.array([region.x, region.y])
+        pieces.append(sw.shadow(q)[0])
+        stats["samples"] = 1
+    else:
+        for ring in _rings(shapely.orient_polygons(region, exterior_cw=False)):
+            v = np.asarray(ring.coords)[:, :2]
+            for a, b in zip(v[:-1], v[1:], strict=True):
+                got, st = sw.along(a, b)
+                pieces += got
+                for k in stats:
+                    stats[k] += st[k]
+    return polygonal(shapely.union_all(pieces)), stats
+
+
+def _region_pts(region: shapely.Geometry) -> np.ndarray:
+    if region.geom_type == "Point":
+        return np.array([[region.x, region.y]])
+    return np.asarray(region.exterior.coords)[:-1, :2]

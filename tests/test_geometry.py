@@ -213,10 +213,12 @@ def test_bad_arguments_fail_clearly():
         complete_region(sc, target_in="home")
     with pytest.raises(ValueError, match="model"):
         recognizable_region(sc, model="weak")
-    with pytest.raises(NotImplementedError, match="3.2.2"):
-        partial_region(sc, target_in="goal")
-    with pytest.raises(NotImplementedError, match="3.2.2"):
-        recognizable_region(sc, model="partial")
+    with pytest.raises(ValueError, match="tol"):
+        partial_region(sc, target_in="goal", tol=0.0)
+    with pytest.raises(ValueError, match="tol"):
+        partial_region(sc, target_at=(0, 0, 0), tol=0.1)
+    with pytest.raises(NotImplementedError, match="orientation"):
+        partial_region(sc, target_in="goal", theta=None)
     with pytest.raises(NotImplementedError, match="orientation"):
         recognizable_region(scene(), model="partial", theta=None)
 
