@@ -100,7 +100,7 @@ class Sweeper:
     strips: list[shapely.Geometry] | None
     eps_aim: float
     tol: float
-    n_samples: int = 4
+    n_samples: int = 2
     max_depth: int = 6
     bisect_steps: int = 14
     probes: int = 16
@@ -123,6 +123,7 @@ class Sweeper:
                     segs.append(np.hstack([c[:-1], c[1:]]))
                     owner.append(np.full(len(c) - 1, i))
                 shapely.prepare(u)
+        self._frames: dict[tuple[float, float], tuple] = {}
         self._cut_segs = np.vstack(segs)
         self._cut_edge = np.concatenate(owner)
         shapely.prepare(self.free)
@@ -404,9 +405,13 @@ class Sweeper:
 
         def frame(t: float) -> tuple:
             if t not in frames:
-                shadow, table, tid = self.shadow(q0 + t * dq)
-                frames[t] = (shadow, self._edges(shadow, table, tid))
-                stats["samples"] += 1
+                q = q1 if t == 1.0 else q0 + t * dq
+                key = (float(q[0]), float(q[1]))
+                if key not in self._frames:  # shared by the edges meeting at a vertex of G
+                    shadow, table, tid = self.shadow(q)
+                    self._frames[key] = (shadow, self._edges(shadow, table, tid))
+                    stats["samples"] += 1
+                frames[t] = self._frames[key]
             return frames[t]
 
         ts = [float(t) for t in np.linspace(0.0, 1.0, self.n_samples + 1)]
