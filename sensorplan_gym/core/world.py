@@ -25,9 +25,12 @@ Target motion (``motion``)
 ``"translating"`` the target is anywhere in G (resp. H) at orientation 0
                   (``theta=0.0`` in the geometry).
 ``"rotating"``    anywhere in G/H at any orientation (``theta=None``).
-Combinations the geometry does not support (for instance ``model="partial"``
-with polygonal G/H, or ``"rotating"`` with the partial model) raise
-``NotImplementedError`` carrying the geometry's message.
+With ``model="partial"`` and polygonal G/H the region is the paper's 5.2
+construction (swept shadows of the non-confusable part of the target, built
+once per scene and configuration: about 1 s on a bundled scene).  Combinations
+the geometry does not support (``"rotating"`` with the partial model, or a point
+G with a polygonal H in the partial model) raise ``NotImplementedError``
+carrying the geometry's message.
 """
 
 from __future__ import annotations
