@@ -1,6 +1,7 @@
 """Wall time of the exact region queries versus scene size.
 
-Run ``python -m benchmarks.regions`` (``--quick`` for fewer repetitions).
+Run ``python -m benchmarks.regions`` (``--quick`` for fewer repetitions).  It ends
+with the swept partial queries of :mod:`benchmarks.swept` (``--no-swept`` skips them).
 
 For generated scenes with about 25, 50, 100 and 200 environment edges (walls plus
 obstacle edges, :func:`geometry.generate.scene_with_edges`) it times every query
@@ -163,6 +164,9 @@ def main(argv: list[str] | None = None) -> str:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="fewer repetitions, 20x20 grid")
     ap.add_argument("--reps", type=int, default=None, help="repetitions per measurement")
+    ap.add_argument(
+        "--no-swept", action="store_true", help="skip the swept partial queries (benchmarks.swept)"
+    )
     args = ap.parse_args(argv)
     reps = args.reps or (5 if args.quick else 15)
 
@@ -241,6 +245,10 @@ def main(argv: list[str] | None = None) -> str:
     print(text)
     RESULTS.parent.mkdir(parents=True, exist_ok=True)
     RESULTS.write_text("# Region query benchmark (`python -m benchmarks.regions`)\n\n" + text)
+    if not args.no_swept:  # the swept partial queries (paper 3.2.2-3.2.3, 5.2): seconds each
+        from . import swept
+
+        swept.main(["--quick"] if args.quick else [])
     return text
 
 
