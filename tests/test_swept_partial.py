@@ -269,3 +269,58 @@ def test_recognizable_partial_polygonal_against_sampled_oracle():
                 flags[k] &= bool(np.bincount(owner[seen], minlength=n_q).astype(bool).all())
         _tally(pool, seed, pts, region, cons, good_b, good_i, tol, sc.diameter)
     pool.check("recognizable_region(model='partial'), polygonal G and H")
+
+
+# ---- properties and bad input --------------------------------------------------------------
+
+
+def test_swept_region_properties():
+    for seed in (31, 32):
+        sc = _scene(seed)
+        loose = partial_region(sc, target_in="goal", theta=0.0)
+        cons = partial_region(sc, target_in="goal", theta=0.0, conservative=True)
+        tol = 1e-4 * sc.diameter
+        assert cons.difference(loose).area <= 1e-9 * sc.diameter**2
+        assert loose.difference(cons).area > 0  # conservative really is smaller
+        # moving through G can only lose placements: inside the stationary region at every vertex
+        for x, y in np.asarray(sc.goal_geom.exterior.coords)[:-1]:
+            still = partial_region(sc, target_at=(x, y, 0.0))
+            assert loose.difference(still).area <= 1e-9 * sc.diameter**2
+        # a coarser tolerance moves the answer by at most about that tolerance
+        coarse = partial_region(sc, target_in="goal", theta=0.0, tol=100 * tol)
+        assert shapely.hausdorff_distance(coarse, loose, densify=0.05) < 0.05 * sc.diameter
+
+
+def test_swept_bad_input_is_named():
+    sc = _scene(41)
+    with pytest.raises(ValueError, match="tol"):
+        partial_region(sc, target_in="goal", tol=-1.0)
+    with pytest.raises(ValueError, match="tol"):
+        recognizable_region(sc, model="partial", tol=float("nan"))
+    with pytest.raises(NotImplementedError, match="same kind"):
+        g = sc.goal_geom.representative_point()
+        recognizable_region(sc.replace(goal=[[g.x, g.y]]), model="partial")
+    # a target with an empty kernel (a zig-zag) is refused with the reason
+    from geometry.sweep import star_center
+
+    hooks = np.array(
+        [[0, 0], [3, 0], [3, 2], [1, 2], [1, 3], [3, 3], [3, 3.2], [0.8, 3.2], [0.8, 1.8],
+         [2.8, 1.8], [2.8, 0.2], [0, 0.2]],
+        dtype=float,
+    )  # fmt: skip
+    assert shapely.Polygon(hooks).is_valid
+    assert star_center(np.array([[0, 0], [1, 0], [1, 1], [0, 1]], dtype=float)) is not None
+    assert star_center(hooks) is None
+
+
+if __name__ == "__main__":  # python -m tests.test_swept_partial --slow [N]: the README's numbers
+    import sys
+
+    n = int(sys.argv[2]) if len(sys.argv) > 2 else 40
+    pool = _check_swept(range(100, 100 + n))
+    print(
+        f"{n} scenes: agreement {pool.agree}/{pool.total} = {pool.agree / pool.total:.5%}, "
+        f"{pool.blinded} blinded; members blinded by a sampled q: {len(pool.inside_bad)} "
+        f"(by an interior q only: {len(pool.interior_bad)}); conservative members blinded: "
+        f"{len(pool.cons_bad)}"
+    )
