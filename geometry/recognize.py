@@ -27,8 +27,6 @@ import numpy as np
 import shapely
 
 from ._common import (
-    OUTER,
-    QUAD_SEGS,
     _triangles,
     check_eps,
     polygonal,
@@ -37,8 +35,7 @@ from ._common import (
     target_spec,
 )
 from .complete import complete_region
-from .partial import ROTATING_PARTIAL, _ccw_ring, swept_tol, weak_visibility
-from .sweep import swept_shadows
+from .partial import ROTATING_PARTIAL, _ccw_ring, _swept_region, swept_tol, weak_visibility
 
 if TYPE_CHECKING:  # pragma: no cover
     from .scene import Scene
@@ -124,26 +121,19 @@ def _swept_recognizable(
     """Paper 5.2: the non-overlap part A'(q) of the target swept through G and
     through H; the two partial regions intersected."""
     target = _ccw_ring(scene.target_at(0.0, 0.0, theta))
-    regions = []
-    for me, other in (("goal", "failure"), ("failure", "goal")):
-        spec = target_spec(scene, None, me, theta)
-        strips = overlap_strips(target, scene.region(other))
-        shadows, _ = swept_shadows(
-            scene_domain(scene),
-            scene.free_space,
-            target,
-            scene.region(me),
-            strips=strips,
-            eps_aim=eps_aim,
-            tol=tol,
+    regions = [
+        _swept_region(
+            scene,
+            me,
+            theta,
+            eps_pos,
+            eps_aim,
+            tol,
+            conservative,
+            strips=overlap_strips(target, scene.region(other)),
         )
-        if conservative:
-            shadows = shapely.buffer(shadows, tol * OUTER, quad_segs=QUAD_SEGS)
-        allowed = shapely.difference(scene.free_space, spec.area)
-        reg = polygonal(shapely.difference(allowed, shadows))
-        if eps_pos > 0:
-            reg = shrink_for_position(reg, allowed, eps_pos)
-        regions.append(reg)
+        for me, other in (("goal", "failure"), ("failure", "goal"))
+    ]
     return polygonal(shapely.intersection(*regions))
 
 
