@@ -78,6 +78,11 @@ def partial_region(
     eps_pos : worst-case placement error (scene units): shadows grown by the disc.
     eps_aim : worst-case aim error (radians): visibility polygons whose apex angle
         at their anchor vertex is below ``eps_aim`` are dropped (paper section 4).
+        With ``target_in`` it shapes the shadows at the sample configurations; the
+        traces between samples are validated by the exact (aim-free) point test, so
+        shadow edges that exist only because of ``eps_aim`` are not traced between
+        samples (the answer may keep placements that the construction would drop
+        at an intermediate configuration).
     tol : only with ``target_in``: the shadow boundaries traced by free vertices
         (lines and conics) are emitted as polylines whose chords stay within
         ``tol`` (scene units) of the curves; default ``1e-4 * scene.diameter``.
