@@ -12,25 +12,21 @@ Along one edge q(t) = q0 + t D of G (0 <= t <= 1) the shadow S(t) changes
 continuously.  Every edge of S(t) lies on a line through two *anchor points*:
 environment vertices (fixed), target vertices (moving with q), or the ends of
 the target's wanted pieces (moving along a fixed line, 5.2).  A point of the
-union of the S(t) that is in neither end shadow lies on the boundary of some
-S(t).  A shadow edge on a line that rotates about one fixed anchor, next to a
-fixed line or a reflex shadow corner, sweeps a set that the shadows before and
-after already cover (the union of a rotating half-plane is the union of its two
-end positions).  What the sampled shadows miss is swept by the *free
-vertices* where two moving lines meet at a convex shadow corner: those trace
-lines or conics (the paper's "free shadow vertices tracing lines and conics").
-So the union is
+union of the S(t) that is in no sampled shadow lies on the boundary of some
+S(t), on an edge whose line moves, so the union is
 
     the exact stationary shadows at sample times t_k  (paper 3.2.1)
-    plus, for every convex corner of two moving lines found in a sample,
-    the area swept by its two edges while the corner exists.
+    plus the area swept by the moving shadow edges between the samples.
 
-The corner and the far ends of its edges are traced in closed form (line
-intersections at any t); a trace is kept where an exact point test (below)
-confirms that the corner is still a shadow corner, with the end of its life
-located by bisection.  The traces are emitted as polylines fine enough that
-every chord lies within ``tol`` of its arc (conic arcs have no inflection, so
-the sagitta at the parameter midpoint, checked on a doubling grid, bounds it).
+Each moving edge found at a sample is traced toward the neighbouring samples
+in closed form: its ends are the intersections of its line with its
+neighbours' lines at any t, and they run on lines or conics (the paper's free
+shadow vertices).  A trace is kept while an exact point test (below) on probes
+just inside the shadow along the edge confirms it; the end of its life (a
+critical event) is located by bisection.  Edges whose sweep lies inside the two
+neighbouring shadows (they rotate into their own shadow) are not traced.  The
+traces are polylines fine enough that every chord lies within ``tol`` of its
+curve (the sagitta at the parameter midpoint, checked on a doubling grid).
 
 Exact point test: the obstacles do not meet K = CH(A (+) G) (the paper's
 assumption, checked by :class:`Scene`), so a ray that enters K reaches
@@ -39,10 +35,12 @@ K (its *windows*) do not depend on q; p sees a wanted piece of A_q iff some
 window overlaps a direction in which, ignoring the obstacles, that piece is
 the first thing hit on A_q.
 
-Shadows born and dying between two sample times without ever touching a
-sampled shadow are found by refining the samples where the shadow of the
-eroded target (the part of A common to the whole interval, whose shadow
-contains the union over the interval) has a component the lower bound misses.
+Samples are added where a moving line carries shadow edges at both ends of an
+interval but the traces leave part of it uncovered (an edge configuration born
+and gone in between), and where the shadow of the eroded target (the part of A
+common to the whole interval, whose shadow contains every S(t) there) has a
+component that neither neighbouring shadow meets (a shadow born and gone in
+between).  What this does not prove is listed in docs/DESIGN.md.
 """
 
 from __future__ import annotations
@@ -666,12 +664,6 @@ def _rings(g: shapely.Geometry) -> list:
         out.append(poly.exterior)
         out.extend(poly.interiors)
     return out
-
-
-def _unit(v: np.ndarray) -> np.ndarray:
-    n = np.hypot(v[..., 0], v[..., 1])
-    with np.errstate(divide="ignore", invalid="ignore"):
-        return v / n[..., None]
 
 
 def _rot(v: np.ndarray) -> np.ndarray:
