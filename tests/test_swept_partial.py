@@ -214,8 +214,14 @@ def _wanted(scene: Scene, q: np.ndarray, other: Polygon, theta: float):
 
 
 def test_recognizable_partial_polygonal_against_sampled_oracle():
+    _check_recognizable((21, 22, 23)).check(
+        "recognizable_region(model='partial'), polygonal G and H"
+    )
+
+
+def _check_recognizable(seeds) -> Pool:
     pool = Pool()
-    for seed in (21, 22, 23):
+    for seed in seeds:
         sc = _scene(seed, convex_target=True)
         rng = np.random.default_rng(seed)
         region = recognizable_region(sc, model="partial", theta=0.0)
@@ -268,7 +274,7 @@ def test_recognizable_partial_polygonal_against_sampled_oracle():
                 )
                 flags[k] &= bool(np.bincount(owner[seen], minlength=n_q).astype(bool).all())
         _tally(pool, seed, pts, region, cons, good_b, good_i, tol, sc.diameter)
-    pool.check("recognizable_region(model='partial'), polygonal G and H")
+    return pool
 
 
 # ---- properties and bad input --------------------------------------------------------------
@@ -317,10 +323,11 @@ if __name__ == "__main__":  # python -m tests.test_swept_partial --slow [N]: the
     import sys
 
     n = int(sys.argv[2]) if len(sys.argv) > 2 else 40
-    pool = _check_swept(range(100, 100 + n))
-    print(
-        f"{n} scenes: agreement {pool.agree}/{pool.total} = {pool.agree / pool.total:.5%}, "
-        f"{pool.blinded} blinded; members blinded by a sampled q: {len(pool.inside_bad)} "
-        f"(by an interior q only: {len(pool.interior_bad)}); conservative members blinded: "
-        f"{len(pool.cons_bad)}"
-    )
+    for what, check in (("3.2.2 swept", _check_swept), ("5.2 recognizable", _check_recognizable)):
+        pool = check(range(100, 100 + n))
+        print(
+            f"{what}, {n} scenes: agreement {pool.agree}/{pool.total} = {pool.agree / pool.total:.5%}, "
+            f"{pool.blinded} blinded; members blinded by a sampled q: {len(pool.inside_bad)} "
+            f"(by an interior q only: {len(pool.interior_bad)}); conservative members blinded: "
+            f"{len(pool.cons_bad)}"
+        )
