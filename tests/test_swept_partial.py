@@ -326,7 +326,8 @@ if __name__ == "__main__":  # python -m tests.test_swept_partial --slow [N]: the
     for what, check in (("3.2.2 swept", _check_swept), ("5.2 recognizable", _check_recognizable)):
         pool = check(range(100, 100 + n))
         print(
-            f"{what}, {n} scenes: agreement {pool.agree}/{pool.total} = {pool.agree / pool.total:.5%}, "
+            f"{what}, {n} scenes: agreement {pool.agree}/{pool.total} "
+            f"= {pool.agree / pool.total:.5%}, "
             f"{pool.blinded} blinded; members blinded by a sampled q: {len(pool.inside_bad)} "
             f"(by an interior q only: {len(pool.interior_bad)}); conservative members blinded: "
             f"{len(pool.cons_bad)}"
