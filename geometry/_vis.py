@@ -232,12 +232,16 @@ def gaps_many(
     sectors: np.ndarray | None = None,
     extra: np.ndarray | None = None,
     flat: bool = False,
+    interior: bool = False,
 ) -> list[Gaps] | tuple[Gaps, np.ndarray]:
     """:func:`gaps_from` for many viewpoints at once (one vectorised ray cast).
 
     ``q`` is (n, 2); ``sectors`` is an (n, 2) array of ``(start, width)`` (a NaN
     row means the full circle); ``extra`` is (n, k) extra critical directions (NaN
     entries ignored).
+
+    ``interior=True`` promises that no viewpoint lies on the boundary (it skips
+    the local-obstruction test).
 
     Returns one :class:`Gaps` per viewpoint, or with ``flat=True`` all gaps in
     one :class:`Gaps` (``q`` then holds one row per gap) plus the (n+1,) offsets
@@ -252,9 +256,14 @@ def gaps_many(
         has = ~np.isnan(sectors[:, 0])
         start[has] = sectors[has, 0]
         width[has] = np.minimum(sectors[has, 1], TAU)
-    w1, w2, along = _blocking(dom, q)
-    d = dom.vert[None, :, :] - q[:, None, :]
-    cols = [np.where(np.abs(d).max(axis=2) > tol, np.arctan2(d[..., 1], d[..., 0]), np.nan)]
+    if interior:
+        w1 = w2 = along = np.full((n, 2), np.nan)
+        d = dom.vert[None, :, :] - q[:, None, :]
+        cols = [np.arctan2(d[..., 1], d[..., 0])]
+    else:
+        w1, w2, along = _blocking(dom, q)
+        d = dom.vert[None, :, :] - q[:, None, :]
+        cols = [np.where(np.abs(d).max(axis=2) > tol, np.arctan2(d[..., 1], d[..., 0]), np.nan)]
     if extra is not None:
         cols.append(extra)
     cols.append(

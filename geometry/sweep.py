@@ -98,10 +98,10 @@ class Sweeper:
     strips: list[shapely.Geometry] | None
     eps_aim: float
     tol: float
-    n_samples: int = 2
+    n_samples: int = 1
     max_depth: int = 6
     bisect_steps: int = 14
-    probes: int = 16
+    probes: int = 4
     _cut_segs: np.ndarray = field(init=False, repr=False)
     _cut_edge: np.ndarray = field(init=False, repr=False)
 
@@ -281,7 +281,7 @@ class Sweeper:
     def _windows(self, p: np.ndarray, base: np.ndarray, sectors: np.ndarray) -> tuple:
         """Directions (relative to ``base``) inside ``sectors`` (start, width) in
         which each p sees into K."""
-        g, off = gaps_many(self.env, p, sectors=sectors, flat=True)
+        g, off = gaps_many(self.env, p, sectors=sectors, flat=True, interior=True)
         own = np.repeat(np.arange(len(p)), np.diff(off))
         ok = g.seg >= 0
         g_lo, g_hi, own, seg = g.lo[ok], g.hi[ok], own[ok], g.seg[ok]
@@ -605,6 +605,51 @@ class Sweeper:
                 return ts
             n = 2 * n - 1
 
+    def _between_lines(self, vs: np.ndarray, d: np.ndarray, ts: np.ndarray, q0, dq) -> np.ndarray:
+        """Fractions along each edge (E, T, K) between consecutive crossings of the
+        lines that can bound a visible beam: through a convex obstacle corner and a
+        target vertex, or through two convex obstacle corners.  Between two such
+        crossings blindness along the edge does not change."""
+        b, i, j = self._corners_and_tangents()
+        if len(b) == 0:
+            return np.full(vs.shape[:-1] + (0,), np.nan)
+        a = self.ring0[None, None, :, :] + (q0 + ts[..., None] * dq)[..., None, :]  # (E, T, m, 2)
+        w = a[..., None, :, :] - b[None, None, :, None, :]  # (E, T, R, m, 2)
+        rel = b[None, None, :, None, :] - vs[..., None, None, :]
+        dd = d[..., None, None, :]
+        # only lines tangent to the obstacle at b can bound a beam
+        bp = self.env.vert_prev[self.env.reflex][None, None, :, None, :] - b[None, None, :, None, :]
+        bn = self.env.vert_next[self.env.reflex][None, None, :, None, :] - b[None, None, :, None, :]
+        tangent = _cross(w, bp) * _cross(w, bn) >= 0
+        with np.errstate(divide="ignore", invalid="ignore"):
+            s1 = np.where(tangent, _cross(rel, w) / _cross(dd, w), np.nan)
+            s1 = s1.reshape(vs.shape[:-1] + (-1,))
+            wf = (b[j] - b[i])[None, None]
+            relf = b[i][None, None] - vs[..., None, :]
+            s2 = _cross(relf, wf) / _cross(d[..., None, :], wf)
+            # lines through two target vertices (a non-convex target hiding itself)
+            ii, jj = np.triu_indices(self.m, 1)
+            wt = (self.ring0[jj] - self.ring0[ii])[None, None]
+            relt = a[..., ii, :] - vs[..., None, :]
+            s3 = _cross(relt, wt) / _cross(d[..., None, :], wt)
+        return _between(np.concatenate([s1, s2, s3], axis=-1))
+
+    def _corners_and_tangents(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Convex obstacle corners, and the pairs (i, j) of them whose joining line is
+        tangent to the obstacles at both (cached)."""
+        got = getattr(self, "_tangents", None)
+        if got is None:
+            b = self.env.vert[self.env.reflex]
+            bp = self.env.vert_prev[self.env.reflex] - b
+            bn = self.env.vert_next[self.env.reflex] - b
+            i, j = np.triu_indices(len(b), 1)
+            w = b[j] - b[i]
+            ok = (_cross(w, bp[i]) * _cross(w, bn[i]) >= 0) & (
+                _cross(w, bp[j]) * _cross(w, bn[j]) >= 0
+            )
+            got = self._tangents = (b, i[ok], j[ok])
+        return got
+
     def _valid_many(self, vs: np.ndarray, ve: np.ndarray, ts: np.ndarray, q0, dq) -> np.ndarray:
         """(E, T) bool: the traced edge is a shadow edge at that time (exact point
         test on probes just inside the shadow along the edge)."""
@@ -614,16 +659,37 @@ class Sweeper:
             u = d / ln[..., None]
         h = np.minimum(self.h, 0.05 * ln)[..., None]
         nrm = _rot(u) * (1e-3 * h)
-        fr = np.arange(1, self.probes) / self.probes
+        fr = np.broadcast_to(np.arange(1, self.probes) / self.probes, ln.shape + (self.probes - 1,))
+        fr = np.concatenate([fr, self._between_lines(vs, d, ts, q0, dq)], axis=-1)
+        fr = np.where(np.isfinite(fr), fr, 0.5)
         probes = [vs + h * u + nrm, ve - h * u + nrm]
-        probes += [vs + f * d + nrm for f in fr]
-        probes = np.stack(probes, axis=-2)  # (E, T, P, 2)
+        probes = np.concatenate(
+            [np.stack(probes, axis=-2), vs[..., None, :] + fr[..., None] * d[..., None, :]], axis=-2
+        ) + np.concatenate(
+            [
+                np.zeros_like(nrm)[..., None, :].repeat(2, -2),
+                nrm[..., None, :].repeat(fr.shape[-1], -2),
+            ],
+            axis=-2,
+        )  # (E, T, P, 2)
         q = np.broadcast_to((q0 + ts[..., None] * dq)[..., None, :], probes.shape)
         flat_p, flat_q = probes.reshape(-1, 2), q.reshape(-1, 2)
         finite = np.isfinite(flat_p).all(axis=1)
         res = np.zeros(len(flat_p), dtype=bool)
         res[finite] = self.blind(flat_p[finite], flat_q[finite])
         return res.reshape(probes.shape[:-1]).all(axis=-1) & (ln > 0)
+
+
+def _between(s: np.ndarray) -> np.ndarray:
+    """Midpoints between consecutive sorted values of ``s`` (..., L) inside (0, 1);
+    NaN-padded to the largest count."""
+    s = np.where((s > 0) & (s < 1), s, np.nan)
+    s = np.sort(s, axis=-1)  # NaN last
+    k = int(np.max(np.sum(np.isfinite(s), axis=-1), initial=0))
+    if k == 0:
+        return np.full(s.shape[:-1] + (0,), np.nan)
+    s = s[..., :k]
+    return 0.5 * (s[..., 1:] + s[..., :-1]) if k > 1 else np.full(s.shape[:-1] + (0,), np.nan)
 
 
 def _overlaps(a_lo, a_hi, a_own, b_lo, b_hi, b_own, n: int, eps: float = 1e-12) -> np.ndarray:
