@@ -661,7 +661,8 @@ class Sweeper:
         nrm = _rot(u) * (1e-3 * h)
         fr = np.broadcast_to(np.arange(1, self.probes) / self.probes, ln.shape + (self.probes - 1,))
         fr = np.concatenate([fr, self._between_lines(vs, d, ts, q0, dq)], axis=-1)
-        fr = np.where(np.isfinite(fr), fr, 0.5)
+        edge_h = (h[..., 0] / np.where(ln > 0, ln, 1.0))[..., None]
+        fr = np.clip(np.where(np.isfinite(fr), fr, 0.5), edge_h, 1 - edge_h)  # ends: probed above
         probes = [vs + h * u + nrm, ve - h * u + nrm]
         probes = np.concatenate(
             [np.stack(probes, axis=-2), vs[..., None, :] + fr[..., None] * d[..., None, :]], axis=-2
