@@ -86,8 +86,10 @@ def partial_region(
     tol : only with ``target_in``: the shadow boundaries traced by free vertices
         (lines and conics) are emitted as polylines whose chords stay within
         ``tol`` (scene units) of the curves; default ``1e-4 * scene.diameter``.
-    conservative : only with ``target_in``: grow the shadows by ``tol`` so that
-        the answer lies inside the exact region (safe for planning).
+    conservative : only with ``target_in``: grow the shadows by ``tol``, so that
+        the answer lies inside the exact region as long as the sweep misses no
+        shadow deeper than ``tol`` (none deeper than 0.003 ``tol`` was measured;
+        see docs/DESIGN.md, "What is and is not guaranteed").
 
     Returns
     -------
