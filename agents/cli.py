@@ -4,6 +4,8 @@
     sensorplan evaluate --env sensorplan/Navigate-v0 --policies oracle random \\
         agents/pretrained/ppo_navigate_lab.zip --episodes 200 --seed 0
     sensorplan demo            (the paper's surveillance scenario end to end; see agents.demo)
+    sensorplan convert plan.geojson scene.json   (GeoJSON / WKT / scene JSON, by extension;
+                                                  see geometry.formats)
 """
 
 from __future__ import annotations
@@ -34,7 +36,7 @@ def build_parser() -> argparse.ArgumentParser:
         prog="sensorplan",
         description="Sensor planning (Briggs & Donald): train and evaluate agents, run the demo.",
     )
-    sub = parser.add_subparsers(dest="command", metavar="{train,evaluate,demo}")
+    sub = parser.add_subparsers(dest="command", metavar="{train,evaluate,demo,convert}")
     sub.required = True
 
     t = sub.add_parser(
@@ -110,6 +112,19 @@ def build_parser() -> argparse.ArgumentParser:
     sub.add_parser(
         "demo", help="the paper's surveillance scenario end to end (agents.demo)", add_help=False
     )
+
+    c = sub.add_parser(
+        "convert",
+        help="convert a map between scene JSON, GeoJSON and WKT",
+        description="Convert a scene: the format follows each file's extension -- .json "
+        "(scene JSON; on input a GeoJSON FeatureCollection is also recognised), .geojson "
+        "(FeatureCollection with properties.role = bounds/obstacle/target/goal/failure/start) "
+        "or .wkt ('role: WKT' lines).  The input is fully validated; obstacles with holes are "
+        "split into simple polygons.  See geometry.formats for the formats.",
+    )
+    c.add_argument("input", help="input file (.json, .geojson or .wkt)")
+    c.add_argument("output", help="output file (.json, .geojson or .wkt)")
+    c.add_argument("--name", default=None, help="scene name (default: from the input)")
     return parser
 
 
@@ -122,6 +137,17 @@ def main(argv: list[str] | None = None) -> int:
         return int(rc or 0)
     args = build_parser().parse_args(argv)
     try:
+        if args.command == "convert":
+            from geometry.formats import load_scene_file, save_scene_file
+
+            scene = load_scene_file(args.input, name=args.name)
+            save_scene_file(scene, args.output)
+            n_edges = len(scene.bounds) + sum(len(o) for o in scene.obstacles)
+            print(
+                f"{args.input} -> {args.output}: scene {scene.name!r}, "
+                f"{len(scene.obstacles)} obstacles, {n_edges} edges"
+            )
+            return 0
         if args.command == "train":
             from .train import train
 
