@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["main"]
+__all__ = ["figure_15", "figure_16", "main", "merge_short_legs"]
 
 PRETRAINED = [
     Path(__file__).parent / "pretrained" / "ppo_navigate_lab.zip",
@@ -32,55 +32,182 @@ PRETRAINED = [
 ]
 
 
-def _figure_15(scene, region, path: Path) -> None:
+def merge_short_legs(path: np.ndarray, min_len: float) -> np.ndarray:
+    """The way points of ``path`` ((N, 2), world frame) without degenerate legs.
+
+    A way point is dropped when the leg that ends at it is shorter than ``min_len``
+    (scene units); the start and the end are always kept.  The planner keeps path corners a
+    hair off the obstacles, which can leave a leg of a fraction of a millimetre at a corner:
+    such legs are not worth a line in a figure or a count in the text.
+    """
+    p = np.asarray(path, dtype=float)
+    if len(p) <= 2:
+        return p
+    keep = [p[0]]
+    for q in p[1:-1]:
+        if np.hypot(*(q - keep[-1])) >= min_len:
+            keep.append(q)
+    if len(keep) > 1 and np.hypot(*(p[-1] - keep[-1])) < min_len:
+        keep.pop()  # the last kept corner is a hair from the end: the end replaces it
+    keep.append(p[-1])
+    return np.asarray(keep)
+
+
+def _legend(ax) -> None:
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, framealpha=1.0)
+
+
+def figure_15(scene, region):
+    """Figure 15 analogue: the complete-visibility region of G (a matplotlib Figure)."""
     import matplotlib.pyplot as plt
 
     from geometry.plot import draw_region, draw_scene
 
-    fig, ax = plt.subplots(figsize=(7, 6))
-    draw_region(ax, region, label="complete visibility of the doorway G")
-    draw_scene(ax, scene)
-    ax.set_title("Figure 15: placements that see all of the target anywhere in G")
-    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
-    fig.savefig(path, dpi=120, bbox_inches="tight")
-    plt.close(fig)
+    fig, ax = plt.subplots(figsize=(8, 6))
+    draw_region(
+        ax,
+        region,
+        color="#74c476",
+        alpha=0.6,
+        edgecolor="#238b45",
+        linewidth=1.0,
+        label=f"complete visibility of the target anywhere in G ({region.area:.1f} m²)",
+    )
+    draw_scene(ax, scene, unit="m")
+    ax.set_title("Figure 15: placements that see all of the target anywhere in G", fontsize=11)
+    _legend(ax)
+    return fig
 
 
-def _figure_16(scene, world, plan, start, path: Path) -> None:
+def figure_16(scene, world, plan, start, margin: float):
+    """Figure 16 analogue: recognizable and shrunk regions, the chosen placement, its aim
+    and the motion to it, with a zoom on the margin band (a matplotlib Figure)."""
     import matplotlib.pyplot as plt
 
     from geometry.plot import draw_pose, draw_region, draw_scene
 
-    fig, ax = plt.subplots(figsize=(7, 6))
-    draw_region(ax, world.region, color="#bdbdbd", alpha=0.6, label="recognizable region")
-    if plan.placement is not None and plan.placement.region is not None:
-        draw_region(ax, plan.placement.region, label="shrunk region")
-    draw_scene(ax, scene)
+    fig, ax = plt.subplots(figsize=(8, 6))
+    shrunk = plan.placement.region if plan.placement is not None else None
+    # zoom window: around the boundary point of the region nearest to the chosen placement,
+    # where the safety margin between the two regions shows
+    axes = [ax]
+    zoom = None
+    if plan.status == "ok" and shrunk is not None and not shrunk.is_empty:
+        import shapely
+
+        edge = shapely.shortest_line(world.region.boundary, shapely.Point(plan.point))
+        cx, cy = np.asarray(edge.coords[0])
+        half = max(8 * margin, 0.02 * world.diameter)
+        zoom = ax.inset_axes([1.04, 0.0, 0.42, 0.42])
+        axes.append(zoom)
+    for a in axes:
+        main = a is ax
+        draw_region(
+            a,
+            world.region,
+            color="#c7e9c0",
+            alpha=1.0,
+            edgecolor="#238b45",
+            linewidth=1.4 if main else 2.0,
+            linestyle="--",
+            label=(
+                f"recognizable region R(G)∩R(H)−C(G,H) ({world.region.area:.2f} m²)"
+                if main
+                else None
+            ),
+        )
+        if shrunk is not None:
+            draw_region(
+                a,
+                shrunk,
+                color="#31a354",
+                alpha=0.75,
+                label=(
+                    f"shrunk by a {margin * 100:.1f} cm safety margin ({shrunk.area:.2f} m²)"
+                    if main
+                    else None
+                ),
+            )
+        draw_scene(a, scene, unit="m", legend_labels=main)
     ax.plot(start[0], start[1], "s", color="black", ms=7, label="start (cannot tell G from H)")
     if plan.status == "ok":
-        p = np.asarray(plan.path)
-        motion = "one-step motion" if plan.one_step else "shortest path"
-        ax.plot(p[:, 0], p[:, 1], "-", color="#ff7f0e", lw=2, label=motion)
-        draw_pose(
-            ax,
-            plan.point[0],
-            plan.point[1],
-            plan.aim,
-            fov=world.fov,
-            length=0.06 * world.diameter,
-            color="#ff7f0e",
-            label="chosen placement",
+        p = merge_short_legs(plan.path, 1e-3 * world.diameter)
+        legs = len(p) - 1
+        motion = (
+            f"one-step motion ({plan.length:.2f} m)"
+            if legs == 1
+            else f"shortest path around obstacles: {legs} legs, {plan.length:.2f} m"
         )
-    ax.set_title("Figure 16: shrunk region, chosen placement and motion")
-    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
+        for a in axes:
+            a.plot(
+                p[:, 0],
+                p[:, 1],
+                "-",
+                color="#ff7f0e",
+                lw=2,
+                label=motion if a is ax else None,
+                zorder=5,
+            )
+            draw_pose(
+                a,
+                plan.point[0],
+                plan.point[1],
+                plan.aim,
+                fov=world.fov,
+                length=0.06 * world.diameter if a is ax else 0.3 * half,
+                color="black",
+                label="chosen placement" if a is ax else None,
+                aim_color="#7b3294",
+                aim_label=f"aim {math.degrees(plan.aim):.1f}°" if a is ax else None,
+            )
+    if zoom is not None:
+        zoom.set_xlim(cx - half, cx + half)
+        zoom.set_ylim(cy - half, cy + half)
+        zoom.set_title(
+            f"zoom, {2 * half:.2f} m wide: the light band is the margin",
+            fontsize=7,
+        )
+        zoom.tick_params(labelsize=6)
+        zoom.set_xlabel("x (m)", fontsize=7)
+        zoom.set_ylabel("y (m)", fontsize=7)
+        ax.indicate_inset_zoom(zoom, edgecolor="black")
+    ax.set_title("Figure 16: shrunk region, chosen placement, aim and motion", fontsize=11)
+    _legend(ax)
+    return fig
+
+
+def _save(fig, path: Path) -> None:
+    import matplotlib.pyplot as plt
+
     fig.savefig(path, dpi=120, bbox_inches="tight")
+    plt.close(fig)
+
+
+def _save_with_legend(frame: np.ndarray, title: str, path: Path) -> None:
+    """The env frame next to a legend of what the env renderer draws."""
+    import matplotlib.pyplot as plt
+
+    from sensorplan_gym.core.rendering import legend_handles
+
+    h, w, _ = frame.shape
+    fig = plt.figure(figsize=(w / 100 + 2.6, h / 100 + 0.3), dpi=100)
+    ax = fig.add_axes((0, 0, w / 100 / (w / 100 + 2.6), 1 - 0.3 / (h / 100 + 0.3)))
+    ax.imshow(frame)
+    ax.set_axis_off()
+    fig.suptitle(title, fontsize=9, x=0.02, ha="left")
+    fig.legend(
+        handles=legend_handles(),
+        loc="center right",
+        fontsize=8,
+        frameon=False,
+    )
+    fig.savefig(path, dpi=100)
     plt.close(fig)
 
 
 def _recognize(out: Path, seed: int) -> tuple[str, str, int]:
     """One Recognize-v0 episode with the oracle; returns (truth, declared, steps)."""
     import gymnasium as gym
-    from PIL import Image
 
     import sensorplan_gym  # noqa: F401
 
@@ -97,7 +224,12 @@ def _recognize(out: Path, seed: int) -> tuple[str, str, int]:
         steps += 1
         done = term or trunc
         if done:
-            Image.fromarray(env.render()).save(out / "recognize_lab.png")
+            _save_with_legend(
+                env.render(),
+                f"Recognize-v0 on lab after {steps} steps: declared {info.get('declared')}, "
+                f"the target was in {info.get('target_in')}",
+                out / "recognize_lab.png",
+            )
     drv = oracle.drivers[0]
     if drv.decision is not None:
         print(f"   readings: {drv.decision.n_points} target points; {drv.decision.reason}")
@@ -137,11 +269,12 @@ def main(argv: list[str] | None = None) -> int:
         f"   complete-visibility region of the doorway: area {vis.area:.2f} m^2, "
         f"computed exactly in {1e3 * (time.perf_counter() - t):.1f} ms"
     )
-    _figure_15(scene, vis, out / "fig15_visibility.png")
+    _save(figure_15(scene, vis), out / "fig15_visibility.png")
 
     world = World(scene, WorldConfig())
     start = scene.start
-    plan = plan_viewpoint(world, start[:2])
+    margin = 2e-3 * world.diameter  # plan_viewpoint's default safety margin, named here
+    plan = plan_viewpoint(world, start[:2], margin=margin)
     print(
         f"2. Recognizable region R(G) n R(H) - C(G,H): area {world.region.area:.2f} m^2; "
         f"start {tuple(round(v, 2) for v in start[:2])} recognizes: "
@@ -150,12 +283,13 @@ def main(argv: list[str] | None = None) -> int:
     if plan.status != "ok":
         print(f"   no placement: {plan.reason}")
         return 1
-    kind = "one-step motion" if plan.one_step else f"shortest path with {len(plan.path) - 1} legs"
+    legs = len(merge_short_legs(plan.path, 1e-3 * world.diameter)) - 1
+    kind = "one-step motion" if legs == 1 else f"shortest path with {legs} legs"
     print(
         f"   chosen placement ({plan.point[0]:.2f}, {plan.point[1]:.2f}), aim "
         f"{math.degrees(plan.aim):.1f} deg, {kind} of {plan.length:.2f} m"
     )
-    _figure_16(scene, world, plan, start, out / "fig16_placement.png")
+    _save(figure_16(scene, world, plan, start, margin), out / "fig16_placement.png")
 
     truth, declared, steps = _recognize(out, args.seed)
     verdict = "correct" if truth == declared else "WRONG"

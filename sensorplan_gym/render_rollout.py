@@ -4,7 +4,8 @@
 
 Runs one episode (or ``--steps`` steps, whichever ends first) with random actions, keeps
 ``--frames`` evenly spaced frames (the first and the last included) and writes them side
-by side in rows of ``--cols``.  Extra ``--kw key=value`` pairs go to ``gym.make`` (values
+by side in rows of ``--cols``, each panel numbered with the env step it shows.
+Extra ``--kw key=value`` pairs go to ``gym.make`` (values
 are parsed as JSON when possible, e.g. ``--kw fov_deg=120 --kw scene='"edr"'``).
 For Recognize-v0 the random agent only declares in the last step.
 """
@@ -48,20 +49,45 @@ def rollout_frames(env_id: str, *, steps: int = 60, seed: int = 0, **kwargs) -> 
     return frames
 
 
+def pick_frames(n_frames: int, n: int) -> np.ndarray:
+    """Indices of ``n`` evenly spaced frames out of ``n_frames`` (first and last included)."""
+    return np.unique(np.linspace(0, n_frames - 1, min(n, n_frames)).round().astype(int))
+
+
 def contact_sheet(frames: list[np.ndarray], n: int, cols: int) -> np.ndarray:
-    idx = np.unique(np.linspace(0, len(frames) - 1, min(n, len(frames))).round().astype(int))
-    pick = [frames[i] for i in idx]
-    h, w, _ = pick[0].shape
-    rows = -(-len(pick) // cols)
-    sheet = np.full(
-        (rows * h + (rows - 1) * 4, min(cols, len(pick)) * w + (min(cols, len(pick)) - 1) * 4, 3),
-        255,
-        np.uint8,
-    )
-    for k, f in enumerate(pick):
+    """``n`` evenly spaced frames in rows of ``cols``, each panel headed by its number and
+    the env step it shows (``frames[0]`` is the frame after ``reset``: step 0).  Returns an
+    RGB uint8 image."""
+    fig = sheet_figure(frames, n, cols)
+    fig.canvas.draw()
+    return np.ascontiguousarray(np.asarray(fig.canvas.buffer_rgba())[:, :, :3])
+
+
+def sheet_figure(frames: list[np.ndarray], n: int, cols: int):
+    """The matplotlib Figure behind :func:`contact_sheet` (one titled axes per panel)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    idx = pick_frames(len(frames), n)
+    h, w, _ = frames[idx[0]].shape
+    ncol = min(cols, len(idx))
+    rows = -(-len(idx) // cols)
+    head = 22  # pixels above each panel for its caption
+    dpi = 100
+    fig = Figure(figsize=(ncol * (w + 4) / dpi, rows * (h + head + 4) / dpi), dpi=dpi)
+    FigureCanvasAgg(fig)
+    fig.set_facecolor("white")
+    last = len(frames) - 1
+    for k, i in enumerate(idx):
         r, c = divmod(k, cols)
-        sheet[r * (h + 4) : r * (h + 4) + h, c * (w + 4) : c * (w + 4) + w] = f
-    return sheet
+        x0 = c * (w + 4) / (ncol * (w + 4))
+        y0 = 1 - (r + 1) * (h + head + 4) / (rows * (h + head + 4))
+        ax = fig.add_axes((x0, y0, w / (ncol * (w + 4)), h / (rows * (h + head + 4))))
+        ax.imshow(frames[i])
+        ax.set_axis_off()
+        what = " (reset)" if i == 0 else (" (last)" if i == last else "")
+        ax.set_title(f"{k + 1}/{len(idx)}: step {i} of {last}{what}", fontsize=9, pad=3)
+    return fig
 
 
 def main(argv=None) -> None:

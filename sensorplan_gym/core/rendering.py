@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["Renderer", "HumanViewer"]
+__all__ = ["Renderer", "HumanViewer", "legend_handles"]
 
 
 def _path(geom):
@@ -35,6 +35,47 @@ def _path(geom):
     if not verts:
         return None
     return Path(np.concatenate(verts), np.concatenate(codes))
+
+
+def legend_handles() -> list:
+    """Matplotlib legend proxies for what :class:`Renderer` draws, in the same colours
+    (frames carry no legend of their own: put these next to a frame, e.g.
+    ``fig.legend(handles=legend_handles())``)."""
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+
+    return [
+        Patch(fc="white", ec="black", lw=1.5, label="room (walls)"),
+        Patch(fc="#9a9a9a", ec="none", label="outside the room"),
+        Patch(fc="#454545", ec="black", lw=0.8, label="obstacles"),
+        Patch(fc="#7fd37f", ec="#2e8b2e", lw=0.6, alpha=0.55, label="recognizable region"),
+        Patch(fc="#1f5fd1", ec="#1f5fd1", alpha=0.45, label="G: goal region"),
+        Patch(fc="#d12f2f", ec="#d12f2f", alpha=0.45, label="H: failure region"),
+        Patch(fc="none", ec="#7a2fbf", lw=1.4, ls="--", label="target (hidden from the agent)"),
+        Line2D(
+            [],
+            [],
+            marker="o",
+            ls="none",
+            ms=9,
+            mfc="#ff8c1a",
+            mec="black",
+            label="robot, not recognizing",
+        ),
+        Line2D(
+            [],
+            [],
+            marker="o",
+            ls="none",
+            ms=9,
+            mfc="#2e8b2e",
+            mec="black",
+            label="robot, recognizing",
+        ),
+        Patch(fc="#ffcc66", ec="none", alpha=0.3, label="field of view"),
+        Line2D([], [], color="#e08a00", lw=0.8, label="range beams"),
+        Line2D([], [], marker=".", ls="none", ms=5, color="#b35f00", label="beam hits"),
+    ]
 
 
 class Renderer:
