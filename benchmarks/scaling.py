@@ -1,0 +1,199 @@
+"""Scaling of the exact region queries to thousands of edges, with an anchor.
+
+    python -m benchmarks.scaling                 # 100 .. 8000 edges (several minutes)
+    python -m benchmarks.scaling --max-edges 1600 --reps 5
+
+For scenes from :func:`geometry.generate.scene_with_edges` (``seed=1``) with 100, 200,
+400, 800, 1,600, 3,200 and 8,000 environment edges, and for the bundled large office
+floor (``sensorplan_gym/scenes/large/office_floor.json``), it times with
+``time.perf_counter`` (median over ``--reps`` warm calls on one Scene, the per-scene
+structures already built):
+
+* ``complete_region`` of a stationary target (at a point of G, orientation 0.3),
+* ``partial_region`` of the same stationary target,
+* ``recognizable_region(model="complete", theta=0.3)`` (polygonal G and H),
+
+and, **in the same run on the same scenes**, the anchor: one CGAL visibility polygon
+(pyvispoly's triangular expansion, ``compute_visibility_polygon``) at each of 20 free
+points, median per point.  The table gives each median, its ratio to the anchor, and
+the log-log growth slope (least squares over 100 .. 1,600 edges).  Written to
+``benchmarks/results/scaling.md``.  pyvispoly is optional (dev extra); without it the
+anchor columns are empty.  The machine is shared: quote ratios and medians.
+"""
+
+from __future__ import annotations
+
+import argparse
+import platform
+import statistics
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+import shapely
+
+from geometry import Scene, complete_region, partial_region, recognizable_region
+from geometry.generate import scene_with_edges
+
+EDGES = (100, 200, 400, 800, 1600, 3200, 8000)
+SEED = 1
+RESULTS = Path(__file__).resolve().parent / "results" / "scaling.md"
+OFFICE = (
+    Path(__file__).resolve().parent.parent
+    / "sensorplan_gym"
+    / "scenes"
+    / "large"
+    / "office_floor.json"
+)
+
+
+def _pose(s: Scene) -> tuple[float, float, float]:
+    c = s.goal_geom.representative_point()
+    return (c.x, c.y, 0.3 if s.name.startswith("bench") else 0.0)
+
+
+QUERIES: list[tuple[str, Callable[[Scene], object]]] = [
+    ("complete, stationary", lambda s: complete_region(s, target_at=_pose(s))),
+    ("partial, stationary", lambda s: partial_region(s, target_at=_pose(s))),
+    (
+        "recognizable, complete",
+        lambda s: recognizable_region(
+            s, model="complete", theta=0.3 if s.name.startswith("bench") else 0.0
+        ),
+    ),
+]
+
+
+def _median_time(fn: Callable[[], object], reps: int, budget: float) -> float:
+    """Median seconds of ``fn`` over up to ``reps`` calls after one warm call; stops
+    early once ``budget`` seconds are spent (at least one timed call)."""
+    t0 = time.perf_counter()
+    fn()
+    first = time.perf_counter() - t0
+    times: list[float] = []
+    spent = first
+    while len(times) < reps and (not times or spent + first < budget):
+        t0 = time.perf_counter()
+        fn()
+        dt = time.perf_counter() - t0
+        times.append(dt)
+        spent += dt
+    return statistics.median(times)
+
+
+def _anchor(s: Scene, n_points: int = 20) -> float | None:
+    """Median seconds of one pyvispoly (CGAL) visibility polygon at free points of ``s``."""
+    try:
+        import pyvispoly as pv
+    except ImportError:
+        return None
+
+    def ring(coords: np.ndarray, ccw: bool) -> pv.Polygon:
+        a = np.asarray(coords)[:-1]
+        area2 = np.sum(a[:, 0] * np.roll(a[:, 1], -1) - np.roll(a[:, 0], -1) * a[:, 1])
+        if (area2 > 0) != ccw:
+            a = a[::-1]
+        return pv.Polygon([pv.Point(float(x), float(y)) for x, y in a])
+
+    fs = s.free_space
+    polys = [fs] if fs.geom_type == "Polygon" else list(fs.geoms)
+    big = max(polys, key=lambda p: p.area)
+    calc = pv.VisibilityPolygonCalculator(
+        pv.PolygonWithHoles(
+            ring(big.exterior.coords, True), [ring(h.coords, False) for h in big.interiors]
+        )
+    )
+    rng = np.random.default_rng(0)
+    x0, y0, x1, y1 = big.bounds
+    shapely.prepare(big)
+    pts: list[tuple[float, float]] = []
+    while len(pts) < n_points:
+        x, y = rng.uniform(x0, x1), rng.uniform(y0, y1)
+        if big.contains(shapely.Point(x, y)):
+            pts.append((x, y))
+    times = []
+    for x, y in pts:
+        q = pv.Point(x, y)
+        t0 = time.perf_counter()
+        calc.compute_visibility_polygon(q)
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times)
+
+
+def _slope(xs: list[float], ys: list[float]) -> float:
+    return float(np.polyfit(np.log(xs), np.log(ys), 1)[0])
+
+
+def _fmt_ms(t: float | None) -> str:
+    if t is None:
+        return "-"
+    ms = 1e3 * t
+    return f"{ms:,.0f}" if ms >= 100 else f"{ms:.1f}" if ms >= 1 else f"{ms:.2f}"
+
+
+def run(edges: tuple[int, ...], reps: int, budget: float, office: bool = True) -> str:
+    rows = []
+    cases: list[tuple[str, int, Scene]] = []
+    for n in edges:
+        d = scene_with_edges(n, SEED)
+        cases.append((str(n), n, Scene.from_dict(d)))
+    if office and OFFICE.exists():
+        s = Scene.load(OFFICE)
+        cases.append(("office floor", len(s.bounds) + sum(len(o) for o in s.obstacles), s))
+    times: dict[str, dict[int, float]] = {q: {} for q, _ in QUERIES}
+    for label, n, s in cases:
+        anchor = _anchor(s)
+        row = [label, str(n), _fmt_ms(anchor)]
+        for qname, fn in QUERIES:
+            t = _median_time(lambda fn=fn, s=s: fn(s), reps, budget)
+            if label.isdigit():
+                times[qname][n] = t
+            ratio = f"{t / anchor:,.0f}x" if anchor else "-"
+            row.append(f"{_fmt_ms(t)} ({ratio})")
+            print(f"  {label:>12} edges={n:5d} {qname:24s} {_fmt_ms(t):>8} ms", flush=True)
+        rows.append(row)
+    slopes = []
+    for qname, _ in QUERIES:
+        pts = sorted((n, t) for n, t in times[qname].items() if 100 <= n <= 1600)
+        slopes.append(f"{_slope(*zip(*pts, strict=True)):.2f}" if len(pts) >= 2 else "-")
+    head = (
+        "| scene | edges | pyvispoly point query, ms | "
+        + " | ".join(f"{q}, ms (x anchor)" for q, _ in QUERIES)
+        + " |"
+    )
+    lines = [
+        f"Machine: {platform.processor() or platform.machine()}, Python "
+        f"{platform.python_version()}; median of up to {reps} warm calls; anchor = median "
+        "CGAL visibility polygon (pyvispoly) at 20 free points of the same scene, same run.",
+        "",
+        head,
+        "|" + " --- |" * (3 + len(QUERIES)),
+        *("| " + " | ".join(r) + " |" for r in rows),
+        "| growth slope 100 -> 1,600 | | | " + " | ".join(slopes) + " |",
+    ]
+    return "\n".join(lines) + "\n"
+
+
+def main(argv: list[str] | None = None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--max-edges", type=int, default=max(EDGES))
+    ap.add_argument("--reps", type=int, default=5)
+    ap.add_argument(
+        "--budget", type=float, default=20.0, help="seconds per query and scene (fewer reps)"
+    )
+    ap.add_argument("--no-office", action="store_true", help="skip the bundled office floor")
+    ap.add_argument("--out", type=Path, default=RESULTS)
+    args = ap.parse_args(argv)
+    edges = tuple(n for n in EDGES if n <= args.max_edges)
+    table = run(edges, args.reps, args.budget, office=not args.no_office)
+    print(table)
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    cmd = "python -m benchmarks.scaling" + (
+        f" --max-edges {args.max_edges}" if args.max_edges != max(EDGES) else ""
+    )
+    args.out.write_text(f"# Scaling of the region queries\n\n`{cmd}`\n\n{table}", encoding="utf-8")
+
+
+if __name__ == "__main__":
+    main()
