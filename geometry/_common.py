@@ -5,9 +5,11 @@ positional-uncertainty shrink of paper section 4."""
 from __future__ import annotations
 
 import math
+import numbers
 import weakref
+from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import shapely
@@ -173,6 +175,75 @@ def _region(scene: Scene, which: str | shapely.Geometry) -> shapely.Geometry:
     if not scene.free_space.covers(which):
         raise ValueError("target_in region is not inside the free space (bounds minus obstacles)")
     return which
+
+
+def as_scene(scene: Any) -> Scene:
+    """``scene`` as a :class:`~geometry.scene.Scene`: a Scene is returned as is, a scene
+    dictionary (the JSON object) is validated; anything else raises ``SceneError``."""
+    from .scene import Scene, SceneError
+
+    if isinstance(scene, Scene):
+        return scene
+    if isinstance(scene, Mapping):
+        return Scene.from_dict(scene)
+    raise SceneError(
+        f"scene must be a geometry.Scene or a scene dictionary, got {type(scene).__name__}"
+    )
+
+
+def _real(v: Any) -> bool:
+    return isinstance(v, numbers.Real) and not isinstance(v, (bool, np.bool_))
+
+
+def check_theta(theta: Any, *, allow_none: bool = True) -> float | None:
+    """Validate a target orientation (radians, a finite real number; ``None`` = any
+    orientation where ``allow_none``).  Strings and booleans are rejected."""
+    if theta is None and allow_none:
+        return None
+    if not _real(theta) or not math.isfinite(float(theta)):
+        want = "a finite number (radians) or None" if allow_none else "a finite number (radians)"
+        raise ValueError(f"theta must be {want}, got {theta!r}")
+    return float(theta)
+
+
+def check_pose(target_at: Any) -> tuple[float, float, float] | None:
+    """Validate ``target_at = (x, y, theta)`` (world frame, radians); ``None`` passes."""
+    if target_at is None:
+        return None
+    try:
+        vals = list(target_at)
+    except TypeError:
+        vals = []
+    if len(vals) != 3 or not all(_real(v) for v in vals):
+        raise ValueError(f"target_at must be (x, y, theta) numbers, got {target_at!r}")
+    x, y, th = (float(v) for v in vals)
+    if not all(math.isfinite(v) for v in (x, y, th)):
+        raise ValueError(f"target_at must be finite, got {target_at!r}")
+    return x, y, th
+
+
+def check_aim(value: Any) -> float:
+    """Validate the aim uncertainty ``eps_aim`` (radians, in [0, pi)): with eps_aim >= pi
+    the aim cone would be every direction."""
+    v = check_eps("eps_aim", value)
+    if v >= math.pi:
+        raise ValueError(
+            f"eps_aim must be in [0, pi) radians (an aim error of pi or more means any "
+            f"direction), got {value!r}"
+        )
+    return v
+
+
+def check_eps_pos(scene: Scene, value: Any) -> float:
+    """Validate the placement uncertainty ``eps_pos`` (scene units, >= 0, below the
+    scene's diameter: a larger error puts the sensor anywhere in the room)."""
+    v = check_eps("eps_pos", value)
+    if v >= scene.diameter:
+        raise ValueError(
+            f"eps_pos={value!r} is not below the scene's diameter ({scene.diameter:.6g} scene "
+            "units): a placement that uncertain could be anywhere in the room"
+        )
+    return v
 
 
 def check_eps(name: str, value: float) -> float:

@@ -24,6 +24,12 @@ import shapely
 
 TAU = 2.0 * np.pi
 
+
+class RayEscapeError(RuntimeError):
+    """A visibility ray from a viewpoint well inside the domain met no boundary segment:
+    the domain's boundary is not closed (a bug in the caller's domain, never bad input)."""
+
+
 __all__ = ["Domain", "Gaps", "gaps_from", "gaps_many", "polygon_from_gaps", "visibility_polygon"]
 
 
@@ -349,8 +355,20 @@ def _first_hits(dom: Domain, q: np.ndarray, phi: np.ndarray) -> np.ndarray:
     tmin = 1e-11 * dom.scale
     t[~((t > tmin) & (s_ >= -1e-12) & (s_ <= 1.0 + 1e-12))] = np.inf
     j = np.argmin(t, axis=1)
-    if not np.all(np.isfinite(t[np.arange(len(j)), j])):
-        raise RuntimeError("visibility ray escaped the domain: the boundary is not closed")
+    lost = ~np.isfinite(t[np.arange(len(j)), j])
+    if lost.any():
+        # A viewpoint within tmin of a segment it is not on (e.g. an obstacle vertex 1e-11
+        # off a wall it lies flush on) sees that segment at t < tmin: the ray leaves the
+        # domain at once, so the direction is blocked.  Anything else is a real escape.
+        ql = q[lost]
+        a = ql[:, None, :] - dom.seg[None, :, :2]
+        e = dom.seg[None, :, 2:] - dom.seg[None, :, :2]
+        ll = np.maximum((e * e).sum(axis=2), 1e-300)
+        tt = np.clip((a * e).sum(axis=2) / ll, 0.0, 1.0)
+        dist = np.hypot(*(a - tt[..., None] * e).transpose(2, 0, 1)).min(axis=1)
+        if np.any(dist > 10.0 * tmin):
+            raise RayEscapeError("visibility ray escaped the domain: the boundary is not closed")
+        j[lost] = -1
     return j
 
 

@@ -27,12 +27,16 @@ import shapely
 
 from ._common import (
     TargetSpec,
-    check_eps,
+    as_scene,
+    check_eps_pos,
+    check_pose,
+    check_theta,
     polygonal,
     scene_domain,
     shrink_for_position,
     target_spec,
 )
+from ._frame import world_messages
 from ._vis import visibility_polygon
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -68,8 +72,31 @@ def complete_region(
     placements inside the bounds, outside every obstacle and outside the
     target's (swept) area, from which every point of the target is visible for
     every admitted target configuration.
+
+    The computation runs in the scene's local frame (:attr:`Scene.frame`: centred, unit
+    size) and the answer is mapped back, so it does not depend on where the scene lies.
+    ``scene`` may also be a scene dictionary (the JSON object).
     """
-    eps_pos = check_eps("eps_pos", eps_pos)
+    scene = as_scene(scene)
+    theta = check_theta(theta)
+    target_at = check_pose(target_at)
+    eps_pos = check_eps_pos(scene, eps_pos)
+    fr = scene.frame
+    with world_messages(fr):
+        out = _complete_region(
+            scene.local, fr.pose(target_at), fr.region(target_in), theta, fr.length(eps_pos)
+        )
+    return fr.to_world(out)
+
+
+def _complete_region(
+    scene: Scene,
+    target_at: tuple[float, float, float] | None,
+    target_in: str | shapely.Geometry | None,
+    theta: float | None,
+    eps_pos: float,
+) -> shapely.Geometry:
+    """:func:`complete_region` on a scene in its local frame (arguments checked)."""
     spec = target_spec(scene, target_at, target_in, theta)
     region = _complete(scene, spec)
     if eps_pos > 0:
@@ -103,51 +130,122 @@ def tangent_wedges(
 
     Each wedge is bounded by the two tangents from ``u`` to the convex set K
     (hull vertices ``spec.hull_pts``, each grown by ``spec.radius``) and is
-    clipped at distance ``scale`` from its apex (beyond the scene).
+    clipped at distance ``1.01 * scale`` from its apex (beyond the scene) by a
+    polygon circumscribing that circular sector.
 
-    Returns the wedges (array of shapely Polygons) and the two tangent points
-    on K, ``(U, 2)`` arrays, of the wedge's clockwise and counter-clockwise sides.
+    A point ``u`` that *touches* K (within ``1e-9 * scale``, the scene's tolerance)
+    gets the tangent cone of K at its nearest boundary point instead: at a vertex of
+    K the wedge is bounded by the lines of K's two edges there, on an edge (or on
+    the smooth boundary of a rotating target's K) it is the open half-plane beyond
+    that edge.  These are the limits of the wedges of points approaching K from
+    outside, so the answer is continuous as an obstacle slides onto K (issue 10,
+    ``min_touch``); the directions from a touching point to K's own vertices are
+    meaningless (0/0) and were used before.
+
+    Returns the wedges (array of shapely Polygons) and two points on the
+    clockwise and counter-clockwise sides' lines on K's side of ``u`` (the
+    tangent points for a non-touching ``u``), ``(U, 2)`` arrays.
     """
     if len(u) == 0:
         return np.empty(0, dtype=object), np.empty((0, 2)), np.empty((0, 2))
     k = spec.hull_pts
+    r = spec.radius
+    tol = 1e-9 * scale
+    n = len(u)
+    rows = np.arange(n)
     base = np.arctan2(u[:, 1] - spec.center[1], u[:, 0] - spec.center[0])
     dx = u[:, None, 0] - k[None, :, 0]
     dy = u[:, None, 1] - k[None, :, 1]
     ang = np.arctan2(dy, dx)
     rel = (ang - base[:, None] + np.pi) % (2 * np.pi) - np.pi
-    if spec.radius > 0:
+    if r > 0:
         dist = np.hypot(dx, dy)
-        spread = np.arcsin(np.clip(spec.radius / np.maximum(dist, 1e-300), 0.0, 1.0))
+        spread = np.arcsin(np.clip(r / np.maximum(dist, 1e-300), 0.0, 1.0))
         i_lo = np.argmin(rel - spread, axis=1)
         i_hi = np.argmax(rel + spread, axis=1)
-        rows = np.arange(len(u))
         lo = (rel - spread)[rows, i_lo]
         hi = (rel + spread)[rows, i_hi]
     else:
         i_lo = np.argmin(rel, axis=1)
         i_hi = np.argmax(rel, axis=1)
-        rows = np.arange(len(u))
         lo = rel[rows, i_lo]
         hi = rel[rows, i_hi]
-    half = 0.5 * (hi - lo)
-    mid = base + 0.5 * (hi + lo)
-    reach = 1.01 * scale
-    far = reach / np.maximum(np.cos(np.minimum(half, np.pi / 2)), 1e-6)
     a_lo = base + lo
     a_hi = base + hi
-    ring = np.stack(
-        [
-            u,
-            u + reach * np.stack([np.cos(a_lo), np.sin(a_lo)], axis=1),
-            u + far[:, None] * np.stack([np.cos(mid), np.sin(mid)], axis=1),
-            u + reach * np.stack([np.cos(a_hi), np.sin(a_hi)], axis=1),
-        ],
-        axis=1,
-    )
-    k_lo = _tangent_point(u, a_lo, k[i_lo], spec.radius)
-    k_hi = _tangent_point(u, a_hi, k[i_hi], spec.radius)
+    k_lo = _tangent_point(u, a_lo, k[i_lo], r)
+    k_hi = _tangent_point(u, a_hi, k[i_hi], r)
+    touch, t_lo, t_hi = _touching_cones(u, k, r, tol)
+    if touch.any():
+        a_lo[touch], a_hi[touch] = t_lo, t_hi
+        k_lo[touch] = u[touch] - np.stack([np.cos(t_lo), np.sin(t_lo)], axis=1)
+        k_hi[touch] = u[touch] - np.stack([np.cos(t_hi), np.sin(t_hi)], axis=1)
+    width = np.clip((a_hi - a_lo) % (2 * np.pi), 0.0, np.pi)
+    # 4 sub-arcs of at most pi/4 on a circle of radius reach / cos(width / 8): the
+    # polygon contains the sector of radius reach and its two sides are exact
+    reach = 1.01 * scale
+    steps = np.arange(5)[None, :] / 4.0
+    phis = a_lo[:, None] + width[:, None] * steps
+    rad = reach / np.cos(width / 8.0)
+    arc = u[:, None, :] + rad[:, None, None] * np.stack([np.cos(phis), np.sin(phis)], axis=2)
+    ring = np.concatenate([u[:, None, :], arc], axis=1)
     return shapely.polygons(ring), k_lo, k_hi
+
+
+def _touching_cones(
+    u: np.ndarray, k: np.ndarray, radius: float, tol: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """For points ``u`` within ``tol`` of K = CH(k) (+) disc(radius): the mask and the
+    side angles ``(lo, hi)`` (counter-clockwise, width <= pi) of the wedge
+    u + cone(p - K) at the nearest boundary point p of K."""
+    n, m = len(u), len(k)
+    if m == 1:
+        a, b = np.repeat(k, 1, axis=0), np.repeat(k, 1, axis=0)
+    else:
+        a, b = k, np.roll(k, -1, axis=0)
+    e = b - a
+    ll = np.maximum((e * e).sum(axis=1), 1e-300)
+    w = u[:, None, :] - a[None, :, :]
+    t = np.clip((w * e[None]).sum(axis=2) / ll[None], 0.0, 1.0)
+    foot = a[None] + t[..., None] * e[None]
+    d = np.hypot(*(u[:, None, :] - foot).transpose(2, 0, 1))
+    j = np.argmin(d, axis=1)
+    rows = np.arange(n)
+    dmin = d[rows, j]
+    if m >= 3:
+        inside = shapely.contains_xy(shapely.Polygon(k), u[:, 0], u[:, 1])
+    else:
+        inside = np.zeros(n, dtype=bool)
+    gap = np.where(inside, -dmin, dmin) - radius
+    touch = np.abs(gap) <= tol if radius > 0 else gap <= tol
+    if not touch.any():
+        return touch, np.empty(0), np.empty(0)
+    idx = np.flatnonzero(touch)
+    jj, tt = j[idx], t[idx, j[idx]]
+    L = np.sqrt(ll[jj])
+    ej = e[jj]
+    out_n = np.stack([ej[:, 1], -ej[:, 0]], axis=1)  # outward normal of a CCW edge
+    nang = np.arctan2(out_n[:, 1], out_n[:, 0])
+    lo = nang - np.pi / 2
+    hi = nang + np.pi / 2
+    if radius > 0 or m < 3:
+        if radius > 0:
+            v = u[idx] - foot[idx, jj]
+            far = np.hypot(v[:, 0], v[:, 1]) > tol
+            nang = np.where(far, np.arctan2(v[:, 1], v[:, 0]), nang)
+            lo, hi = nang - np.pi / 2, nang + np.pi / 2
+        return touch, lo, hi
+    # at a vertex of K: bounded by the lines of the two edges there
+    at_start = tt * L <= tol
+    at_end = (1 - tt) * L <= tol
+    vert = np.where(at_start, jj, (jj + 1) % m)
+    is_v = at_start | at_end
+    nxt, prv = k[(vert + 1) % m], k[(vert - 1) % m]
+    kv = k[vert]
+    a1 = np.arctan2(kv[:, 1] - nxt[:, 1], kv[:, 0] - nxt[:, 0])  # beyond the outgoing edge
+    a2 = np.arctan2(kv[:, 1] - prv[:, 1], kv[:, 0] - prv[:, 0])  # beyond the incoming edge
+    lo = np.where(is_v, a1, lo)
+    hi = np.where(is_v, a1 + (a2 - a1) % (2 * np.pi), hi)
+    return touch, lo, hi
 
 
 def _tangent_point(u: np.ndarray, ang: np.ndarray, k: np.ndarray, radius: float) -> np.ndarray:

@@ -29,12 +29,18 @@ import shapely
 from ._common import (
     OUTER,
     QUAD_SEGS,
+    as_scene,
+    check_aim,
     check_eps,
+    check_eps_pos,
+    check_pose,
+    check_theta,
     polygonal,
     scene_domain,
     shrink_for_position,
     target_spec,
 )
+from ._frame import world_messages
 from ._vis import TAU, Domain, Gaps, clean_polygon, gaps_many
 from .sweep import swept_shadows
 
@@ -95,10 +101,44 @@ def partial_region(
     -------
     A shapely Polygon/MultiPolygon (possibly empty) in world coordinates: the
     placements inside the bounds, outside obstacles and outside the target (for
-    ``target_in``: outside the area the target sweeps).
+    ``target_in``: outside the area the target sweeps).  Computed in the scene's local
+    frame (see :func:`~geometry.complete_region`); ``scene`` may be a scene dictionary.
     """
-    eps_pos = check_eps("eps_pos", eps_pos)
-    eps_aim = check_eps("eps_aim", eps_aim)
+    scene = as_scene(scene)
+    theta = check_theta(theta)
+    target_at = check_pose(target_at)
+    eps_pos = check_eps_pos(scene, eps_pos)
+    eps_aim = check_aim(eps_aim)
+    if tol is not None:
+        tol = check_eps("tol", tol)
+        if tol <= 0:
+            raise ValueError(f"tol must be > 0, got {tol!r}")
+    fr = scene.frame
+    with world_messages(fr):
+        out = _partial_region(
+            scene.local,
+            fr.pose(target_at),
+            fr.region(target_in),
+            theta,
+            fr.length(eps_pos),
+            eps_aim,
+            fr.length(tol),
+            conservative,
+        )
+    return fr.to_world(out)
+
+
+def _partial_region(
+    scene: Scene,
+    target_at: tuple[float, float, float] | None,
+    target_in: str | shapely.Geometry | None,
+    theta: float | None,
+    eps_pos: float,
+    eps_aim: float,
+    tol: float | None,
+    conservative: bool,
+) -> shapely.Geometry:
+    """:func:`partial_region` on a scene in its local frame (arguments checked)."""
     if target_in is not None:
         if target_at is not None:
             raise ValueError("give exactly one of target_at=(x, y, theta) or target_in=<region>")

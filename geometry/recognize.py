@@ -28,12 +28,17 @@ import shapely
 
 from ._common import (
     _triangles,
+    as_scene,
+    check_aim,
     check_eps,
+    check_eps_pos,
+    check_theta,
     polygonal,
     scene_domain,
     shrink_for_position,
     target_spec,
 )
+from ._frame import world_messages
 from .complete import complete_region
 from .partial import ROTATING_PARTIAL, _ccw_ring, _swept_region, swept_tol, weak_visibility
 
@@ -74,12 +79,38 @@ def recognizable_region(
 
     Returns
     -------
-    A shapely Polygon/MultiPolygon in world coordinates, possibly empty.
+    A shapely Polygon/MultiPolygon in world coordinates, possibly empty.  Computed in
+    the scene's local frame (see :func:`~geometry.complete_region`); ``scene`` may be a
+    scene dictionary.
     """
     if model not in ("complete", "partial"):
         raise ValueError(f"model must be 'complete' or 'partial', got {model!r}")
-    eps_pos = check_eps("eps_pos", eps_pos)
-    eps_aim = check_eps("eps_aim", eps_aim)
+    scene = as_scene(scene)
+    theta = check_theta(theta)
+    eps_pos = check_eps_pos(scene, eps_pos)
+    eps_aim = check_aim(eps_aim)
+    if tol is not None:
+        tol = check_eps("tol", tol)
+        if tol <= 0:
+            raise ValueError(f"tol must be > 0, got {tol!r}")
+    fr = scene.frame
+    with world_messages(fr):
+        out = _recognizable_region(
+            scene.local, model, theta, fr.length(eps_pos), eps_aim, fr.length(tol), conservative
+        )
+    return fr.to_world(out)
+
+
+def _recognizable_region(
+    scene: Scene,
+    model: str,
+    theta: float | None,
+    eps_pos: float,
+    eps_aim: float,
+    tol: float | None,
+    conservative: bool,
+) -> shapely.Geometry:
+    """:func:`recognizable_region` on a scene in its local frame (arguments checked)."""
     if model == "complete":
         if theta is None and symmetric_confusion(scene):
             return shapely.Polygon()
@@ -165,9 +196,17 @@ def overlap_segments(scene: Scene, theta: float = 0.0) -> list[shapely.LineStrin
     direction, with a piece of an edge of A in H: readings there cannot tell G
     from H.  Raises ``ValueError`` unless G and H are points.
     """
+    scene = as_scene(scene)
+    theta = check_theta(theta, allow_none=False)
     g, h = scene.goal_geom, scene.failure_geom
     if g.geom_type != "Point" or h.geom_type != "Point":
         raise ValueError("overlap_segments needs point-sized goal and failure regions")
+    fr = scene.frame
+    return [fr.to_world(s) for s in _overlap_segments(scene.local, theta)]
+
+
+def _overlap_segments(scene: Scene, theta: float) -> list[shapely.LineString]:
+    g, h = scene.goal_geom, scene.failure_geom
     ag = _ccw(scene.target_at(g.x, g.y, theta))
     ah = _ccw(scene.target_at(h.x, h.y, theta))
     e = np.roll(ag, -1, axis=0) - ag

@@ -52,6 +52,8 @@ import shapely
 from shapely.geometry import MultiPolygon, Point, Polygon
 from shapely.geometry.base import BaseGeometry
 
+from ._frame import IDENTITY, Frame, frame_params, to_world_point, world_messages
+
 __all__ = ["SceneError", "SensorSpec", "Scene", "TOL_REL", "PAPER_ASSUMPTION"]
 
 #: Relative tolerance: ``scene.tol = TOL_REL * scene.diameter``.
@@ -67,6 +69,8 @@ REQUIRED_KEYS = ("name", "bounds", "obstacles", "target", "goal", "failure")
 OPTIONAL_KEYS = ("sensor", "start")
 ALLOWED_KEYS = REQUIRED_KEYS + OPTIONAL_KEYS
 SENSOR_KEYS = ("fov_deg", "max_range", "eps_pos", "eps_aim_deg")
+#: Sensor fields measured in scene units (scaled with the scene into its local frame).
+_LENGTH_SENSOR_KEYS = ("max_range", "eps_pos")
 
 
 class SceneError(ValueError):
@@ -87,6 +91,7 @@ def _fmt(v: float) -> str:
 
 
 def _fmt_pt(x: float, y: float) -> str:
+    x, y = to_world_point(x, y)  # local-frame validation names world coordinates
     return f"({_fmt(x)}, {_fmt(y)})"
 
 
@@ -114,7 +119,10 @@ def _readonly(a: np.ndarray) -> np.ndarray:
 
 
 def _signed_area(pts: np.ndarray) -> float:
-    x, y = pts[:, 0], pts[:, 1]
+    """Shoelace area of the ring, computed about the vertices' mean (an uncentred sum loses
+    every digit of a small polygon far from the origin)."""
+    c = pts - pts.mean(axis=0)
+    x, y = c[:, 0], c[:, 1]
     return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
 
 
@@ -218,7 +226,7 @@ class SensorSpec:
         max_range: maximum sensing distance in scene units, or ``None`` for unlimited.
         eps_pos: positional uncertainty of the placement (radius of the epsilon-disc, scene
             units), >= 0.
-        eps_aim_deg: directional (aim) uncertainty in degrees, in [0, 360).
+        eps_aim_deg: directional (aim) uncertainty in degrees, in [0, 180).
     """
 
     fov_deg: float = 360.0
@@ -246,8 +254,11 @@ class SensorSpec:
         if eps < 0.0:
             raise SceneError(f"sensor.eps_pos: must be >= 0, got {self.eps_pos!r}")
         aim = num("eps_aim_deg", self.eps_aim_deg)
-        if not 0.0 <= aim < 360.0:
-            raise SceneError(f"sensor.eps_aim_deg: must be in [0, 360), got {self.eps_aim_deg!r}")
+        if not 0.0 <= aim < 180.0:
+            raise SceneError(
+                f"sensor.eps_aim_deg: must be in [0, 180) (an aim error of 180 degrees or more "
+                f"means any direction), got {self.eps_aim_deg!r}"
+            )
         object.__setattr__(self, "fov_deg", fov)
         object.__setattr__(self, "max_range", rng)
         object.__setattr__(self, "eps_pos", eps)
@@ -448,6 +459,11 @@ class Scene:
         self._validate_geometry()
 
     def _validate_geometry(self) -> None:
+        if not self.frame.identity:
+            # validate the exact image in the local frame (centred, unit size): the same
+            # relative tolerances then mean the same thing at any offset and any scale
+            _ = self.local
+            return
         tol = self.tol
         bpoly = self.bounds_geom
         for i, o in enumerate(self.obstacles):
@@ -528,6 +544,44 @@ class Scene:
         )
 
     # -- derived geometry (cached) ---------------------------------------------------------------
+
+    @functools.cached_property
+    def frame(self) -> Frame:
+        """The local frame of this scene (:mod:`geometry._frame`): ``local = (world - offset)
+        / scale`` with ``scale`` a power of two near the diameter and the offset near the
+        centre of the bounds.  The region functions compute in it."""
+        return frame_params(self.bounds)
+
+    @functools.cached_property
+    def local(self) -> Scene:
+        """This scene mapped into :attr:`frame` (validated there; an identity frame gives
+        the scene itself).  Error messages of its validation name world coordinates."""
+        fr = self.frame
+        if fr.identity:
+            return self
+        sensor = self.sensor.to_dict()
+        sensor["eps_pos"] = self.sensor.eps_pos / fr.scale
+        if self.sensor.max_range is not None:
+            sensor["max_range"] = self.sensor.max_range / fr.scale
+        for k in _LENGTH_SENSOR_KEYS:
+            if k in sensor and k not in ("eps_pos", "max_range"):
+                sensor[k] = sensor[k] / fr.scale
+        d: dict[str, Any] = {
+            "name": self.name,
+            "bounds": fr.points(self.bounds).tolist(),
+            "obstacles": [fr.points(o).tolist() for o in self.obstacles],
+            "target": (self.target / fr.scale).tolist(),
+            "goal": fr.points(self.goal).tolist(),
+            "failure": fr.points(self.failure).tolist(),
+            "sensor": sensor,
+        }
+        if self.start is not None:
+            d["start"] = list(fr.pose(self.start))
+        obj = Scene.__new__(Scene)
+        obj.__dict__["frame"] = IDENTITY
+        with world_messages(fr):
+            obj._setup(d)
+        return obj
 
     @functools.cached_property
     def diameter(self) -> float:

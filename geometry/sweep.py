@@ -52,7 +52,7 @@ import shapely
 from shapely import affinity
 
 from ._common import polygonal
-from ._vis import TAU, Domain, gaps_many
+from ._vis import TAU, Domain, RayEscapeError, gaps_many
 
 __all__ = ["Sweeper", "star_center", "swept_shadows"]
 
@@ -260,12 +260,12 @@ class Sweeper:
             return out
         try:
             out[far] = self._blind(p, q)
-        except RuntimeError:  # a probe on the boundary within float noise: one by one
+        except RayEscapeError:  # defensive: isolate the offending probe, one by one
             idx = np.flatnonzero(far)
             for j in range(len(p)):
                 try:
                     out[idx[j]] = self._blind(p[j : j + 1], q[j : j + 1])[0]
-                except RuntimeError:
+                except RayEscapeError:
                     out[idx[j]] = False
         return out
 

@@ -312,7 +312,8 @@ def test_wrong_types(lab_dict, changes, pattern):
         ({"max_range": 0}, r"sensor\.max_range: must be > 0 or null"),
         ({"max_range": float("inf")}, r"sensor\.max_range: must be finite"),
         ({"eps_pos": -0.1}, r"sensor\.eps_pos: must be >= 0"),
-        ({"eps_aim_deg": 360}, r"sensor\.eps_aim_deg: must be in \[0, 360\)"),
+        ({"eps_aim_deg": 360}, r"sensor\.eps_aim_deg: must be in \[0, 180\)"),
+        ({"eps_aim_deg": 200}, r"sensor\.eps_aim_deg: must be in \[0, 180\)"),
         ({"eps_aim_deg": float("nan")}, r"sensor\.eps_aim_deg: must be finite"),
     ],
 )
