@@ -1,0 +1,368 @@
+"""A per-domain spatial index for the exact visibility computations of :mod:`geometry._vis`.
+
+Every region query is assembled from many angular-gap visibility computations; the
+inner operation is *ray shooting*: the first boundary segment hit by a ray.  Done by
+brute force that is (rays x segments) work -- at 1,600 edges about 2.5 million
+ray/segment tests for one visibility polygon.  This module builds, once per domain, a
+uniform grid of cells (about one per segment), each listing the segments that meet it
+(grown by a float margin), and walks every ray through the cells it crosses (a DDA
+walk, compiled with numba), testing only the segments listed there and stopping at
+the first cell whose exit lies beyond the best hit found.  The hit test is the same
+formula, with the same tolerances, as the brute-force code, so the answer (which
+segment is hit first) is the same -- the index only skips segments that cannot be hit
+earlier; nothing is sampled or approximated.
+
+The same grid answers "which segments pass within ``tol`` of this point" for the
+local-obstruction test of viewpoints on the boundary.
+
+numba is an optional dependency (the ``fast`` extra).  Without it :func:`available`
+is False and :mod:`geometry._vis` keeps its vectorised brute-force code.
+
+A domain extended by :meth:`Domain.with_ring` (the target added as a hole) reuses its
+parent's grid and tests the few added segments by brute force, so the grid of a scene
+is built once (:func:`geometry._common.scene_domain` caches the scene's domain).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+try:  # pragma: no cover - exercised when numba is installed
+    import numba
+
+    _HAVE_NUMBA = True
+except ImportError:  # pragma: no cover
+    numba = None
+    _HAVE_NUMBA = False
+
+if TYPE_CHECKING:  # pragma: no cover
+    from ._vis import Domain
+
+__all__ = ["SegmentGrid", "available", "first_hits", "grid_for", "near_pairs"]
+
+#: Domains with fewer segments than this use the brute-force code (no gain below it).
+MIN_SEGMENTS = 0
+
+#: Registration margin of a segment in the cells, relative to the domain's scale: larger
+#: than every tolerance of the hit test (s in [-1e-12, 1 + 1e-12], boundary tol 1e-12).
+MARGIN_REL = 1e-9
+
+
+def available() -> bool:
+    """True when the compiled index can be used (numba is installed)."""
+    return _HAVE_NUMBA
+
+
+def _njit(f):  # pragma: no cover - trivial
+    return numba.njit(cache=True, nogil=True)(f) if _HAVE_NUMBA else f
+
+
+@dataclass(frozen=True)
+class SegmentGrid:
+    """Uniform grid over segments ``seg`` (E, 4): cell ``(ix, iy)`` lists, in
+    ``items[start[c] : start[c + 1]]`` with ``c = iy * nx + ix``, the segments that meet
+    the cell grown by ``margin``.  ``x0, y0`` is the grid's lower-left corner, ``h`` the
+    cell size (scene units)."""
+
+    seg: np.ndarray
+    x0: float
+    y0: float
+    h: float
+    nx: int
+    ny: int
+    start: np.ndarray
+    items: np.ndarray
+    margin: float
+
+    @staticmethod
+    def build(seg: np.ndarray, scale: float, cells_per_segment: float = 1.0) -> SegmentGrid:
+        seg = np.ascontiguousarray(seg, dtype=np.float64)
+        margin = MARGIN_REL * max(scale, 1e-300)
+        lo = np.minimum(seg[:, :2], seg[:, 2:]).min(axis=0) - 4 * margin
+        hi = np.maximum(seg[:, :2], seg[:, 2:]).max(axis=0) + 4 * margin
+        w, hgt = float(hi[0] - lo[0]), float(hi[1] - lo[1])
+        n_cells = max(1.0, cells_per_segment * len(seg))
+        h = math.sqrt(max(w * hgt, 1e-300) / n_cells)
+        h = max(h, w / 4096, hgt / 4096, 1e-300)
+        nx = max(1, int(math.ceil(w / h)))
+        ny = max(1, int(math.ceil(hgt / h)))
+        counts = _register(seg, float(lo[0]), float(lo[1]), h, nx, ny, margin, None)
+        start = np.zeros(nx * ny + 1, dtype=np.int64)
+        np.cumsum(counts, out=start[1:])
+        items = np.empty(start[-1], dtype=np.int64)
+        _register(seg, float(lo[0]), float(lo[1]), h, nx, ny, margin, (start.copy(), items))
+        return SegmentGrid(seg, float(lo[0]), float(lo[1]), h, nx, ny, start, items, margin)
+
+
+def _register(seg, x0, y0, h, nx, ny, margin, fill):
+    if fill is None:
+        counts = np.zeros(nx * ny, dtype=np.int64)
+        _register_kernel(seg, x0, y0, h, nx, ny, margin, counts, counts, counts, False)
+        return counts
+    pos, items = fill
+    dummy = np.zeros(1, dtype=np.int64)
+    _register_kernel(seg, x0, y0, h, nx, ny, margin, dummy, pos, items, True)
+    return None
+
+
+@_njit
+def _register_kernel(seg, x0, y0, h, nx, ny, margin, counts, pos, items, fill):  # pragma: no cover
+    for j in range(seg.shape[0]):
+        ax, ay, bx, by = seg[j, 0], seg[j, 1], seg[j, 2], seg[j, 3]
+        ix0 = max(0, min(nx - 1, int(math.floor((min(ax, bx) - margin - x0) / h))))
+        ix1 = max(0, min(nx - 1, int(math.floor((max(ax, bx) + margin - x0) / h))))
+        iy0 = max(0, min(ny - 1, int(math.floor((min(ay, by) - margin - y0) / h))))
+        iy1 = max(0, min(ny - 1, int(math.floor((max(ay, by) + margin - y0) / h))))
+        ex, ey = bx - ax, by - ay
+        for iy in range(iy0, iy1 + 1):
+            cy0 = y0 + iy * h - margin
+            cy1 = y0 + (iy + 1) * h + margin
+            for ix in range(ix0, ix1 + 1):
+                cx0 = x0 + ix * h - margin
+                cx1 = x0 + (ix + 1) * h + margin
+                # separating axis: the segment's line vs the (grown) cell's corners
+                s1 = ex * (cy0 - ay) - ey * (cx0 - ax)
+                s2 = ex * (cy0 - ay) - ey * (cx1 - ax)
+                s3 = ex * (cy1 - ay) - ey * (cx0 - ax)
+                s4 = ex * (cy1 - ay) - ey * (cx1 - ax)
+                if (s1 > 0 and s2 > 0 and s3 > 0 and s4 > 0) or (
+                    s1 < 0 and s2 < 0 and s3 < 0 and s4 < 0
+                ):
+                    continue
+                c = iy * nx + ix
+                if fill:
+                    items[pos[c]] = j
+                    pos[c] += 1
+                else:
+                    counts[c] += 1
+
+
+@_njit
+def _hit(qx, qy, dx, dy, sx0, sy0, sx1, sy1, tmin):  # pragma: no cover
+    """Ray parameter t of the hit of ray q + t d with segment s, or inf (same test as
+    :func:`geometry._vis._first_hits`)."""
+    ex = sx1 - sx0
+    ey = sy1 - sy0
+    den = dx * ey - dy * ex
+    if den == 0.0:
+        return math.inf
+    t = ((sx0 * ey - sy0 * ex) - qx * ey + qy * ex) / den
+    s = (dy * sx0 - dx * sy0 + (qy * dx - qx * dy)) / den
+    if t > tmin and s >= -1e-12 and s <= 1.0 + 1e-12:
+        return t
+    return math.inf
+
+
+@_njit
+def _first_hits_kernel(
+    q, phi, seg, x0, y0, h, nx, ny, start, items, extra, extra_base, tmin, out
+):  # pragma: no cover
+    for i in range(phi.shape[0]):
+        qx, qy = q[i, 0], q[i, 1]
+        dx, dy = math.cos(phi[i]), math.sin(phi[i])
+        best_t = math.inf
+        best = -1
+        for k in range(extra.shape[0]):
+            t = _hit(qx, qy, dx, dy, extra[k, 0], extra[k, 1], extra[k, 2], extra[k, 3], tmin)
+            if t < best_t:
+                best_t = t
+                best = extra_base + k
+        ix = int(math.floor((qx - x0) / h))
+        iy = int(math.floor((qy - y0) / h))
+        ix = max(0, min(nx - 1, ix))
+        iy = max(0, min(ny - 1, iy))
+        if dx > 0.0:
+            step_x = 1
+            t_max_x = (x0 + (ix + 1) * h - qx) / dx
+            t_dx = h / dx
+        elif dx < 0.0:
+            step_x = -1
+            t_max_x = (x0 + ix * h - qx) / dx
+            t_dx = -h / dx
+        else:
+            step_x = 0
+            t_max_x = math.inf
+            t_dx = math.inf
+        if dy > 0.0:
+            step_y = 1
+            t_max_y = (y0 + (iy + 1) * h - qy) / dy
+            t_dy = h / dy
+        elif dy < 0.0:
+            step_y = -1
+            t_max_y = (y0 + iy * h - qy) / dy
+            t_dy = -h / dy
+        else:
+            step_y = 0
+            t_max_y = math.inf
+            t_dy = math.inf
+        while True:
+            c = iy * nx + ix
+            for p in range(start[c], start[c + 1]):
+                j = items[p]
+                t = _hit(qx, qy, dx, dy, seg[j, 0], seg[j, 1], seg[j, 2], seg[j, 3], tmin)
+                if t < best_t or (t == best_t and j < best):
+                    best_t = t
+                    best = j
+            if t_max_x < t_max_y:
+                if best_t <= t_max_x:
+                    break
+                ix += step_x
+                if ix < 0 or ix >= nx:
+                    break
+                t_max_x += t_dx
+            else:
+                if best_t <= t_max_y:
+                    break
+                iy += step_y
+                if iy < 0 or iy >= ny:
+                    break
+                t_max_y += t_dy
+        out[i] = best
+
+
+@_njit
+def _near_kernel(q, seg, x0, y0, h, nx, ny, start, items, tol, rows, cols):  # pragma: no cover
+    """(point, segment) pairs whose distance is at most ``tol``, from each point's cell."""
+    n = 0
+    for i in range(q.shape[0]):
+        qx, qy = q[i, 0], q[i, 1]
+        ix = max(0, min(nx - 1, int(math.floor((qx - x0) / h))))
+        iy = max(0, min(ny - 1, int(math.floor((qy - y0) / h))))
+        c = iy * nx + ix
+        for p in range(start[c], start[c + 1]):
+            j = items[p]
+            ax, ay = seg[j, 0], seg[j, 1]
+            ex, ey = seg[j, 2] - ax, seg[j, 3] - ay
+            L2 = ex * ex + ey * ey
+            t = ((qx - ax) * ex + (qy - ay) * ey) / max(L2, 1e-300)
+            t = min(1.0, max(0.0, t))
+            px, py = ax + t * ex - qx, ay + t * ey - qy
+            if px * px + py * py <= tol * tol:
+                if n < rows.shape[0]:
+                    rows[n] = i
+                    cols[n] = j
+                n += 1
+    return n
+
+
+def grid_for(dom: Domain) -> tuple[SegmentGrid, int]:
+    """The grid of ``dom`` (or of the domain it was extended from by ``with_ring``) and the
+    number of leading segments of ``dom`` it covers (the rest are tested by brute force).
+    Built on first use and kept on the domain object."""
+    base = dom
+    while getattr(base, "_parent", None) is not None:
+        base = base._parent
+    grid = getattr(base, "_visindex", None)
+    if grid is None:
+        grid = SegmentGrid.build(base.seg, base.scale)
+        object.__setattr__(base, "_visindex", grid)
+    return grid, len(base.seg)
+
+
+def first_hits(dom: Domain, q: np.ndarray, phi: np.ndarray) -> np.ndarray:
+    """Index of the first segment of ``dom`` hit by rays from ``q`` ((2,) or (k, 2)) at
+    angles ``phi`` (k,), or -1 where a ray escapes -- the same answer as the brute force
+    :func:`geometry._vis._first_hits` (which raises on escapes)."""
+    grid, n_base = grid_for(dom)
+    phi = np.ascontiguousarray(phi, dtype=np.float64)
+    q = np.ascontiguousarray(np.broadcast_to(q, (len(phi), 2)), dtype=np.float64)
+    extra = np.ascontiguousarray(dom.seg[n_base:], dtype=np.float64)
+    out = np.empty(len(phi), dtype=np.int64)
+    _first_hits_kernel(
+        q,
+        phi,
+        grid.seg,
+        grid.x0,
+        grid.y0,
+        grid.h,
+        grid.nx,
+        grid.ny,
+        grid.start,
+        grid.items,
+        extra,
+        n_base,
+        1e-11 * dom.scale,
+        out,
+    )
+    return out
+
+
+def near_pairs(dom: Domain, q: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray]:
+    """Pairs ``(i, j)``: segment ``j`` of ``dom`` passes within ``tol`` of point ``q[i]``
+    (a superset filter; callers apply their exact criteria to the pairs).  Sorted by
+    ``i``.  ``tol`` must not exceed the grid's margin."""
+    grid, n_base = grid_for(dom)
+    if tol > grid.margin:
+        raise ValueError("near_pairs: tol exceeds the grid margin")
+    q = np.ascontiguousarray(q, dtype=np.float64).reshape(-1, 2)
+    cap = 8 * len(q) + 16
+    while True:
+        rows = np.empty(cap, dtype=np.int64)
+        cols = np.empty(cap, dtype=np.int64)
+        n = _near_kernel(
+            q,
+            grid.seg,
+            grid.x0,
+            grid.y0,
+            grid.h,
+            grid.nx,
+            grid.ny,
+            grid.start,
+            grid.items,
+            tol,
+            rows,
+            cols,
+        )
+        if n <= cap:
+            break
+        cap = n
+    rows, cols = rows[:n], cols[:n]
+    if n_base < len(dom.seg):  # the added ring(s): brute force
+        ex = dom.seg[n_base:]
+        a = q[:, None, :] - ex[None, :, :2]
+        e = ex[None, :, 2:] - ex[None, :, :2]
+        L2 = np.maximum((e * e).sum(axis=2), 1e-300)
+        t = np.clip((a * e).sum(axis=2) / L2, 0.0, 1.0)
+        d = a - t[..., None] * e
+        r2, c2 = np.nonzero((d * d).sum(axis=2) <= tol * tol)
+        rows = np.concatenate([rows, r2])
+        cols = np.concatenate([cols, c2 + n_base])
+    order = np.lexsort((cols, rows))
+    return rows[order], cols[order]
+
+
+def blocking(dom: Domain, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`geometry._vis._blocking` from the grid: the same wedges and directions,
+    computed for the (point, segment) pairs of :func:`near_pairs` only instead of for
+    all points x all vertices and segments."""
+    tol = 1e-12 * dom.scale
+    q = np.asarray(q, dtype=float).reshape(-1, 2)
+    n = len(q)
+    w1 = np.full((n, 2), np.nan)
+    w2 = np.full((n, 2), np.nan)
+    along = np.full((n, 2), np.nan)
+    rows, cols = near_pairs(dom, q, 2.0 * tol)
+    if len(rows) == 0:
+        return w1, w2, along
+    # vertex j is the start of segment j (Domain.from_rings / with_ring)
+    vnear = np.abs(dom.vert[cols] - q[rows]).max(axis=1) <= tol
+    r, c = rows[vnear], cols[vnear]
+    if len(r):
+        wedge = dom.vert_wedge[c]
+        first = np.concatenate([[True], r[1:] != r[:-1]])
+        w1[r[first]] = wedge[first]
+        second = ~first & np.concatenate([[False], first[:-1]])
+        w2[r[second]] = wedge[second]
+    s = dom.seg[cols]
+    e = s[:, 2:] - s[:, :2]
+    L = np.hypot(e[:, 0], e[:, 1])
+    a = q[rows] - s[:, :2]
+    dist = np.abs(e[:, 0] * a[:, 1] - e[:, 1] * a[:, 0]) / np.maximum(L, 1e-300)
+    t = (a[:, 0] * e[:, 0] + a[:, 1] * e[:, 1]) / np.maximum(L * L, 1e-300)
+    on = (dist <= tol) & (t * L > tol) & ((1 - t) * L > tol)
+    along[rows[on]] = e[on]
+    return w1, w2, along
