@@ -22,6 +22,8 @@ from dataclasses import dataclass
 import numpy as np
 import shapely
 
+from . import visindex as _visindex
+
 TAU = 2.0 * np.pi
 
 
@@ -107,7 +109,7 @@ class Domain:
         """
         extra = Domain.from_rings([ring], [tag], None if tags is None else [tags])
         r_i = int(self.seg_ring.max()) + 1 if len(self.seg_ring) else 0
-        return Domain(
+        out = Domain(
             seg=np.vstack([self.seg, extra.seg]),
             seg_ring=np.concatenate([self.seg_ring, extra.seg_ring + r_i]),
             seg_tag=np.concatenate([self.seg_tag, extra.seg_tag]),
@@ -118,6 +120,9 @@ class Domain:
             reflex=np.concatenate([self.reflex, extra.reflex]),
             scale=self.scale,
         )
+        # the grid of geometry.visindex is shared with the parent (built once per scene)
+        object.__setattr__(out, "_parent", self)
+        return out
 
 
 def domain_from_geometry(geom: shapely.Geometry, tag: int = 0) -> Domain:
@@ -207,6 +212,8 @@ def _blocking(dom: Domain, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.nd
     (NaN rows when none) and the direction of a segment whose interior contains it
     (NaN when none).  Directions outside a wedge, or to the right of such a segment,
     enter an obstacle at once."""
+    if _visindex.available():
+        return _visindex.blocking(dom, q)
     tol = 1e-12 * dom.scale
     n = len(q)
     near = np.abs(dom.vert[None, :, :] - q[:, None, :]).max(axis=2) <= tol
@@ -330,14 +337,27 @@ def gaps_many(
     ]
 
 
-def _first_hits(dom: Domain, q: np.ndarray, phi: np.ndarray) -> np.ndarray:
+def _first_hits(
+    dom: Domain, q: np.ndarray, phi: np.ndarray, *, brute: bool = False
+) -> np.ndarray:
     """Index of the first segment hit by rays from ``q`` (one point or one per
     ray) at angles ``phi``.
 
     With ray ``q + t d`` and segment ``a + s e``: ``den = d x e``,
     ``t = ((a - q) x e) / den``, ``s = ((a - q) x d) / den``; each numerator is a
     small matrix product over (rays x 3) and (3 x segments).
+
+    With numba installed (and ``brute`` False) the per-domain grid of
+    :mod:`geometry.visindex` runs the same hit test on the segments along each ray
+    only; the rare rays it finds no hit for go to the brute force below.
     """
+    if not brute and _visindex.available():
+        j = _visindex.first_hits(dom, q, phi)
+        lost = j < 0
+        if lost.any():
+            qb = np.broadcast_to(q, (len(phi), 2))
+            j[lost] = _first_hits(dom, qb[lost], phi[lost], brute=True)
+        return j
     q = np.broadcast_to(q, (len(phi), 2))
     dx, dy = np.cos(phi), np.sin(phi)
     x0, y0 = dom.seg[:, 0], dom.seg[:, 1]
