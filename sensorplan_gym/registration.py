@@ -5,7 +5,9 @@ from __future__ import annotations
 
 import gymnasium as gym
 
-__all__ = ["ENV_IDS", "register_sensorplan_envs"]
+__all__ = ["ENV_IDS", "WATCH_ID", "register_sensorplan_envs"]
+
+WATCH_ID = "sensorplan/Watch-v0"
 
 ENV_IDS = {
     "sensorplan/Placement-v0": ("sensorplan_gym.envs.placement:PlacementEnv", 1),
@@ -20,3 +22,6 @@ def register_sensorplan_envs() -> None:
         if env_id in gym.registry:
             continue
         gym.register(id=env_id, entry_point=entry_point, max_episode_steps=steps)
+    # the watch task (issue 11): one watcher; its fixed horizon is part of the task (no TimeLimit)
+    if WATCH_ID not in gym.registry:
+        gym.register(id=WATCH_ID, entry_point="sensorplan_gym.multiagent.gym_env:WatchEnv")
