@@ -6,6 +6,8 @@
     sensorplan demo            (the paper's surveillance scenario end to end; see agents.demo)
     sensorplan convert plan.geojson scene.json   (GeoJSON / WKT / scene JSON, by extension;
                                                   see geometry.formats)
+    sensorplan view lab        (scenes and exact regions in the browser; --export view.html
+                                writes one self-contained file; see sensorplan_gym.viewer)
 """
 
 from __future__ import annotations
@@ -36,7 +38,7 @@ def build_parser() -> argparse.ArgumentParser:
         prog="sensorplan",
         description="Sensor planning (Briggs & Donald): train and evaluate agents, run the demo.",
     )
-    sub = parser.add_subparsers(dest="command", metavar="{train,evaluate,demo,convert}")
+    sub = parser.add_subparsers(dest="command", metavar="{train,evaluate,demo,convert,view}")
     sub.required = True
 
     t = sub.add_parser(
@@ -112,6 +114,12 @@ def build_parser() -> argparse.ArgumentParser:
     sub.add_parser(
         "demo", help="the paper's surveillance scenario end to end (agents.demo)", add_help=False
     )
+    sub.add_parser(
+        "view",
+        help="scenes and exact regions in the browser, live or exported to HTML "
+        '(needs the "viewer" extra; sensorplan view --help)',
+        add_help=False,
+    )
 
     c = sub.add_parser(
         "convert",
@@ -135,6 +143,10 @@ def main(argv: list[str] | None = None) -> int:
 
         rc = demo.main(argv[1:])
         return int(rc or 0)
+    if argv and argv[0] == "view":
+        from sensorplan_gym.viewer.cli import main as view_main  # lazily: Bokeh is an extra
+
+        return int(view_main(argv[1:]) or 0)
     args = build_parser().parse_args(argv)
     try:
         if args.command == "convert":

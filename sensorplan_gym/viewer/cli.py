@@ -1,0 +1,96 @@
+"""``sensorplan view``: look at a scene and its exact regions in the browser.
+
+    sensorplan view lab                      live viewer at http://localhost:5006/
+    sensorplan view my_scene.json --model partial --motion stationary
+    sensorplan view lab --export view.html   one self-contained HTML file, no server
+    sensorplan view lab --rollout ep.json    adds a Replay tab (see sensorplan_gym.viewer.replay)
+
+Needs the ``viewer`` extra (Bokeh): ``pip install -e ".[viewer]"``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+
+__all__ = ["build_parser", "main"]
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog="sensorplan view",
+        description="Show a scene and its exact sensor-placement regions in the browser: a "
+        "live Bokeh app (default) or a self-contained HTML file (--export).",
+        epilog='Needs the "viewer" extra: pip install -e ".[viewer]".',
+    )
+    p.add_argument(
+        "scene",
+        nargs="?",
+        default="lab",
+        help="bundled scene name or path to a scene JSON file (default: lab)",
+    )
+    p.add_argument("--export", metavar="FILE", help="write a self-contained HTML file and exit")
+    p.add_argument("--model", choices=("complete", "partial"), default="complete")
+    p.add_argument(
+        "--motion", choices=("stationary", "translating", "rotating"), default="translating"
+    )
+    p.add_argument(
+        "--eps-pos", type=float, default=None, help="placement error, scene units (default: scene)"
+    )
+    p.add_argument(
+        "--eps-aim-deg", type=float, default=None, help="aim error, degrees (default: scene)"
+    )
+    p.add_argument(
+        "--fov-deg", type=float, default=None, help="field of view, degrees (default: scene)"
+    )
+    p.add_argument("--port", type=int, default=5006, help="server port (0: any free port)")
+    p.add_argument("--no-browser", action="store_true", help="do not open a browser tab")
+    p.add_argument("--rollout", metavar="FILE", help="a saved rollout to replay in a second tab")
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run ``sensorplan view``; returns a process exit code."""
+    args = build_parser().parse_args(argv)
+    try:
+        import bokeh  # noqa: F401
+    except ModuleNotFoundError:
+        print('sensorplan view: error: needs Bokeh: pip install -e ".[viewer]"', file=sys.stderr)
+        return 2
+    from geometry import SceneError
+    from sensorplan_gym.core.world import load_scene
+
+    from .layers import Settings
+
+    try:
+        scene = load_scene(args.scene)
+        over = {
+            "model": args.model,
+            "motion": args.motion,
+            "eps_pos": args.eps_pos,
+            "eps_aim": None if args.eps_aim_deg is None else math.radians(args.eps_aim_deg),
+            "fov": None if args.fov_deg is None else math.radians(args.fov_deg),
+        }
+        settings = Settings.from_scene(scene, **over)
+        if args.export:
+            from .export import export_html
+
+            path = export_html(scene, args.export, settings)
+            print(f"wrote {path} ({path.stat().st_size / 1e6:.1f} MB, self-contained)")
+            return 0
+        if args.rollout:
+            from .replay import load_rollout
+
+            load_rollout(args.rollout)  # fail early on a bad file
+        from .app import serve
+
+        serve(scene, settings, port=args.port, show=not args.no_browser, rollout=args.rollout)
+    except (SceneError, ValueError, FileNotFoundError) as e:
+        print(f"sensorplan view: error: {e}", file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())
