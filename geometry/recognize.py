@@ -135,7 +135,7 @@ def _recognizable_region(
         spec = target_spec(scene, (me.x, me.y, th), None, None)
         ring, wanted = _split_ring(
             _ccw(spec.area),
-            _cuts(_ccw(spec.area), _ccw(scene.target_at(other.x, other.y, th)), scene.diameter),
+            _cuts(_ccw(spec.area), _ccw(scene.target_at(other.x, other.y, th)), *_accuracy(scene)),
         )
         ring_cw, wanted_cw = ring[::-1], np.roll(wanted[::-1], -1)
         reg = weak_visibility(scene_domain(scene), ring_cw, wanted_cw, eps_aim)
@@ -161,31 +161,49 @@ def _swept_recognizable(
             eps_aim,
             tol,
             conservative,
-            strips=overlap_strips(target, scene.region(other)),
+            strips=overlap_strips(target, scene.region(other), *_accuracy(scene)),
         )
         for me, other in (("goal", "failure"), ("failure", "goal"))
     ]
     return polygonal(shapely.intersection(*regions))
 
 
-def overlap_strips(target: np.ndarray, other: shapely.Polygon) -> list[shapely.Geometry]:
+def _accuracy(scene: Scene) -> tuple[float, float]:
+    """``(rho, cos_max)`` of the confusability test (docs/DESIGN.md, "Sensor accuracy"):
+    two readings can agree when their distances differ by at most 2 ``range_acc`` and
+    their normals by at most 2 ``normal_acc``; ``rho`` is never below the scene's
+    tolerance (1e-9 of its diameter) and ``cos_max`` never above 1 - 1e-12."""
+    rho = max(2.0 * scene.range_acc, 1e-9 * scene.diameter)
+    cos_max = min(math.cos(min(2.0 * scene.sensor.normal_acc, math.pi / 2)), 1.0 - 1e-12)
+    return rho, cos_max
+
+
+def overlap_strips(
+    target: np.ndarray, other: shapely.Polygon, rho: float = 0.0, cos_max: float = 1.0 - 1e-12
+) -> list[shapely.Geometry]:
     """Per edge i of ``target`` (counter-clockwise, reference point at the
-    origin): U_i = union of e_j (+) X over the edges j with the same direction,
-    X the *other* region.  A piece of edge i of A_q (q in this region) inside
-    U_i coincides with an edge of A_q' for some q' in X: the overlap O(e_i, e_j)
-    of paper 5.2, which cannot tell the two regions apart."""
+    origin): U_i = (union of e_j (+) X over the edges j whose direction is within
+    ``acos(cos_max)`` of edge i's) grown by ``rho``, X the *other* region.  A piece
+    of edge i of A_q (q in this region) outside U_i is farther than ``rho`` from
+    every edge of every A_q' (q' in X) whose normal is that close to its own, so no
+    reading of it can agree with one of A_q' (the overlap O(e_i, e_j) of paper 5.2,
+    widened by the sensor's accuracy).  The growth is a mitred buffer, which
+    contains the round one (conservative)."""
     e = np.roll(target, -1, axis=0) - target
     u = e / np.hypot(e[:, 0], e[:, 1])[:, None]
     tri = _triangles(other)
     out: list[shapely.Geometry] = []
     for i in range(len(target)):
-        same = np.flatnonzero((u @ u[i]) > 1 - 1e-12)
+        same = np.flatnonzero((u @ u[i]) >= cos_max)
         parts = []
         for j in same:
             a, b = target[j], target[(j + 1) % len(target)]
             pts = np.concatenate([tri + a, tri + b], axis=1)  # (T, 6, 2)
             parts.append(shapely.convex_hull(shapely.multipoints(pts)))
-        out.append(shapely.union_all(np.concatenate(parts)))
+        strip = shapely.union_all(np.concatenate(parts))
+        if rho > 0:
+            strip = shapely.buffer(strip, rho, join_style="mitre", mitre_limit=2.0)
+        out.append(strip)
     return out
 
 
@@ -212,7 +230,7 @@ def _overlap_segments(scene: Scene, theta: float) -> list[shapely.LineString]:
     e = np.roll(ag, -1, axis=0) - ag
     return [
         shapely.LineString([ag[i] + t0 * e[i], ag[i] + t1 * e[i]])
-        for i, t0, t1 in _cuts(ag, ah, scene.diameter)
+        for i, t0, t1 in _cuts(ag, ah, *_accuracy(scene))
     ]
 
 
@@ -220,27 +238,64 @@ def _ccw(poly: shapely.Polygon) -> np.ndarray:
     return np.asarray(shapely.orient_polygons(poly, exterior_cw=False).exterior.coords)[:-1, :2]
 
 
-def _cuts(a: np.ndarray, b: np.ndarray, scale: float) -> list[tuple[int, float, float]]:
-    """Overlaps of the CCW edges of ``a`` with same-direction collinear edges of ``b``:
-    ``(edge index in a, t0, t1)`` with 0 <= t0 < t1 <= 1 along that edge."""
-    tol = 1e-9 * scale
+def _cuts(
+    a: np.ndarray, b: np.ndarray, rho: float, cos_max: float
+) -> list[tuple[int, float, float]]:
+    """Confusable pieces of the CCW edges of ``a`` against the CCW edges of ``b``:
+    ``(edge index in a, t0, t1)`` with 0 <= t0 < t1 <= 1 along that edge, for every
+    edge j of ``b`` whose direction is within ``acos(cos_max)`` of edge i's (same
+    outward side) -- the points of edge i within ``rho`` of edge j.  That set is one
+    interval (the distance to a segment is convex along a line); it is the union of
+    the line's intersections with the slab of j and the discs at j's ends."""
     ea = np.roll(a, -1, axis=0) - a
     eb = np.roll(b, -1, axis=0) - b
     la = np.hypot(ea[:, 0], ea[:, 1])
     lb = np.hypot(eb[:, 0], eb[:, 1])
     ua = ea / la[:, None]
     ub = eb / lb[:, None]
-    same = (ua[:, None, :] * ub[None, :, :]).sum(-1) > 1 - 1e-12
-    off = b[None, :, :] - a[:, None, :]
-    collinear = np.abs(ua[:, None, 0] * off[..., 1] - ua[:, None, 1] * off[..., 0]) <= tol
+    same = (ua[:, None, :] * ub[None, :, :]).sum(-1) >= cos_max
     out = []
-    for i, j in zip(*np.nonzero(same & collinear), strict=False):
-        s0 = float(off[i, j] @ ua[i]) / la[i]
-        s1 = s0 + lb[j] / la[i]
-        t0, t1 = max(0.0, s0), min(1.0, s1)
-        if (t1 - t0) * la[i] > tol:
+    for i, j in zip(*np.nonzero(same), strict=False):
+        lo, hi = _near_interval(a[i], ea[i], b[j], ub[j], lb[j], rho)
+        t0, t1 = max(0.0, lo), min(1.0, hi)
+        if (t1 - t0) * la[i] > 1e-12 * max(la[i], rho):
             out.append((int(i), t0, t1))
     return out
+
+
+def _near_interval(
+    a: np.ndarray, e: np.ndarray, b: np.ndarray, u: np.ndarray, length: float, rho: float
+) -> tuple[float, float]:
+    """Parameters t (unbounded) of the points a + t e within ``rho`` of the segment
+    b -> b + length u, as (lo, hi); lo > hi when there are none."""
+    lo, hi = math.inf, -math.inf
+    # the slab |(x - b) x u| <= rho, 0 <= (x - b) . u <= length
+    w = a - b
+    n = np.array([-u[1], u[0]])
+    s_lo, s_hi = -math.inf, math.inf
+    for c0, c1, bound_lo, bound_hi in (
+        (float(w @ n), float(e @ n), -rho, rho),
+        (float(w @ u), float(e @ u), 0.0, length),
+    ):
+        if abs(c1) <= 1e-300:
+            if not bound_lo <= c0 <= bound_hi:
+                s_lo, s_hi = math.inf, -math.inf
+            continue
+        r0, r1 = sorted(((bound_lo - c0) / c1, (bound_hi - c0) / c1))
+        s_lo, s_hi = max(s_lo, r0), min(s_hi, r1)
+    if s_lo <= s_hi:
+        lo, hi = min(lo, s_lo), max(hi, s_hi)
+    # the discs of radius rho at both ends: |w' + t e|^2 <= rho^2
+    ee = float(e @ e)
+    for end in (b, b + length * u):
+        wq = a - end
+        bq = float(wq @ e)
+        cq = float(wq @ wq) - rho * rho
+        disc = bq * bq - ee * cq
+        if disc >= 0 and ee > 0:
+            r = math.sqrt(disc)
+            lo, hi = min(lo, (-bq - r) / ee), max(hi, (-bq + r) / ee)
+    return lo, hi
 
 
 def _split_ring(
@@ -271,7 +326,10 @@ def symmetric_confusion(scene: Scene) -> bool:
     the configurations (g, t) and (g + (I - R_phi) R_t s, t + phi) produce the same
     outline; over all t the second reference point runs on a circle of radius
     2 |s| sin(phi / 2) about g.  Confusion exists iff that distance is attained
-    between a point of G and a point of H.
+    between a point of G and a point of H.  With the sensor's accuracy, "the same
+    outline" means within Hausdorff distance ``rho`` (2 ``range_acc``, at least the
+    scene tolerance) and the distance test is widened by ``rho`` too (conservative:
+    more scenes are declared confusable).
     """
     a = scene.target_at(0.0, 0.0, 0.0)
     c = np.asarray(a.centroid.coords[0])
@@ -282,7 +340,7 @@ def symmetric_confusion(scene: Scene) -> bool:
     gp = shapely.get_coordinates(g.boundary if g.geom_type == "Polygon" else g)
     hp = shapely.get_coordinates(h.boundary if h.geom_type == "Polygon" else h)
     dmax = float(np.max(np.hypot(*(gp[:, None, :] - hp[None, :, :]).transpose(2, 0, 1))))
-    tol = 1e-9 * max(scene.diameter, 1.0)
+    tol = _accuracy(scene)[0]
     s = math.hypot(*c)
     base = math.atan2(pts[0, 1], pts[0, 0])
     for i in range(1, len(pts)):
@@ -290,7 +348,7 @@ def symmetric_confusion(scene: Scene) -> bool:
             continue
         phi = (math.atan2(pts[i, 1], pts[i, 0]) - base) % (2 * math.pi)
         rot = shapely.affinity.rotate(a, phi, origin=tuple(c), use_radians=True)
-        if shapely.symmetric_difference(rot, a).area <= 1e-9 * a.area:
+        if shapely.hausdorff_distance(rot, a) <= tol:
             rho = 2 * s * math.sin(phi / 2)
             if dmin - tol <= rho <= dmax + tol:
                 return True

@@ -19,7 +19,8 @@ The JSON format (see issue 2)::
       "target":    [[x, y], ...],          # target A in its own frame, (0, 0) inside A
       "goal":      [[x, y], ...],          # G: a polygon, or one point [[x, y]]
       "failure":   [[x, y], ...],          # H: a polygon, or one point [[x, y]]
-      "sensor":    {"fov_deg": 360, "max_range": null, "eps_pos": 0.0, "eps_aim_deg": 0.0},
+      "sensor":    {"fov_deg": 360, "max_range": null, "eps_pos": 0.0, "eps_aim_deg": 0.0,
+                    "range_acc": null, "normal_acc_deg": 0.01},
       "start":     [x, y, theta]           # optional robot start pose (theta in radians)
     }
 
@@ -68,9 +69,13 @@ PAPER_ASSUMPTION = (
 REQUIRED_KEYS = ("name", "bounds", "obstacles", "target", "goal", "failure")
 OPTIONAL_KEYS = ("sensor", "start")
 ALLOWED_KEYS = REQUIRED_KEYS + OPTIONAL_KEYS
-SENSOR_KEYS = ("fov_deg", "max_range", "eps_pos", "eps_aim_deg")
+SENSOR_KEYS = ("fov_deg", "max_range", "eps_pos", "eps_aim_deg", "range_acc", "normal_acc_deg")
 #: Sensor fields measured in scene units (scaled with the scene into its local frame).
-_LENGTH_SENSOR_KEYS = ("max_range", "eps_pos")
+_LENGTH_SENSOR_KEYS = ("max_range", "eps_pos", "range_acc")
+#: Default range accuracy relative to the scene's diameter (``range_acc: null``).
+RANGE_ACC_REL = 1e-6
+#: Default normal accuracy in degrees.
+NORMAL_ACC_DEG = 0.01
 
 
 class SceneError(ValueError):
@@ -227,12 +232,21 @@ class SensorSpec:
         eps_pos: positional uncertainty of the placement (radius of the epsilon-disc, scene
             units), >= 0.
         eps_aim_deg: directional (aim) uncertainty in degrees, in [0, 180).
+        range_acc: accuracy of a distance reading (scene units, >= 0): a reading is within
+            ``range_acc`` of the true distance along the beam.  ``None`` (default) means
+            ``1e-6 * scene.diameter`` (:attr:`Scene.range_acc`), far above the rounding of
+            any input written with 7 significant digits.
+        normal_acc_deg: accuracy of a surface-normal reading in degrees, in [0, 90); default
+            0.01.  Two target edges whose readings can agree within these bounds are
+            confusable (paper 5.1/5.2; docs/DESIGN.md, "Sensor accuracy").
     """
 
     fov_deg: float = 360.0
     max_range: float | None = None
     eps_pos: float = 0.0
     eps_aim_deg: float = 0.0
+    range_acc: float | None = None
+    normal_acc_deg: float = NORMAL_ACC_DEG
 
     def __post_init__(self) -> None:
         def num(name: str, v: Any) -> float:
@@ -259,6 +273,18 @@ class SensorSpec:
                 f"sensor.eps_aim_deg: must be in [0, 180) (an aim error of 180 degrees or more "
                 f"means any direction), got {self.eps_aim_deg!r}"
             )
+        racc = self.range_acc
+        if racc is not None:
+            racc = num("range_acc", racc)
+            if racc < 0.0:
+                raise SceneError(f"sensor.range_acc: must be >= 0 or null, got {self.range_acc!r}")
+        nacc = num("normal_acc_deg", self.normal_acc_deg)
+        if not 0.0 <= nacc < 90.0:
+            raise SceneError(
+                f"sensor.normal_acc_deg: must be in [0, 90), got {self.normal_acc_deg!r}"
+            )
+        object.__setattr__(self, "range_acc", racc)
+        object.__setattr__(self, "normal_acc_deg", nacc)
         object.__setattr__(self, "fov_deg", fov)
         object.__setattr__(self, "max_range", rng)
         object.__setattr__(self, "eps_pos", eps)
@@ -274,6 +300,11 @@ class SensorSpec:
         """Directional (aim) uncertainty in radians."""
         return math.radians(self.eps_aim_deg)
 
+    @property
+    def normal_acc(self) -> float:
+        """Normal-reading accuracy in radians."""
+        return math.radians(self.normal_acc_deg)
+
     @classmethod
     def from_dict(cls, d: Any) -> SensorSpec:
         """Build from the JSON ``sensor`` object (every key optional)."""
@@ -287,12 +318,14 @@ class SensorSpec:
         return cls(**dict(d))
 
     def to_dict(self) -> dict[str, Any]:
-        """All four fields as a JSON-style dictionary."""
+        """All fields as a JSON-style dictionary."""
         return {
             "fov_deg": self.fov_deg,
             "max_range": self.max_range,
             "eps_pos": self.eps_pos,
             "eps_aim_deg": self.eps_aim_deg,
+            "range_acc": self.range_acc,
+            "normal_acc_deg": self.normal_acc_deg,
         }
 
 
@@ -560,11 +593,8 @@ class Scene:
         if fr.identity:
             return self
         sensor = self.sensor.to_dict()
-        sensor["eps_pos"] = self.sensor.eps_pos / fr.scale
-        if self.sensor.max_range is not None:
-            sensor["max_range"] = self.sensor.max_range / fr.scale
         for k in _LENGTH_SENSOR_KEYS:
-            if k in sensor and k not in ("eps_pos", "max_range"):
+            if sensor.get(k) is not None:
                 sensor[k] = sensor[k] / fr.scale
         d: dict[str, Any] = {
             "name": self.name,
@@ -588,6 +618,13 @@ class Scene:
         """Diagonal of the bounds' axis-aligned bounding box (scene units)."""
         lo, hi = self.bounds.min(axis=0), self.bounds.max(axis=0)
         return float(math.hypot(*(hi - lo)))
+
+    @property
+    def range_acc(self) -> float:
+        """The sensor's range accuracy (scene units): ``sensor.range_acc``, or
+        ``RANGE_ACC_REL * diameter`` when that is ``None``."""
+        r = self.sensor.range_acc
+        return RANGE_ACC_REL * self.diameter if r is None else r
 
     @property
     def tol(self) -> float:

@@ -154,9 +154,14 @@ def test_eps_pos_keeps_a_margin_from_shadows():
 def test_overlap_segments_and_partial_recognition():
     rect = [[-1, -0.5], [1, -0.5], [1, 0.5], [-1, 0.5]]
     sc = scene(target=rect, goal=[[0, 0]], failure=[[1.2, 0]])
-    segs = sorted(tuple(sorted(np.round(s.coords, 12).tolist())) for s in overlap_segments(sc))
+    exact = sc.replace(sensor={"range_acc": 0.0})
+    segs = sorted(tuple(sorted(np.round(s.coords, 6).tolist())) for s in overlap_segments(exact))
     segs = [tuple(map(tuple, s)) for s in segs]
     assert segs == [((0.2, -0.5), (1.0, -0.5)), ((0.2, 0.5), (1.0, 0.5))]
+    # the default range accuracy (1e-6 of the diameter) widens them by 2 range_acc
+    rho = 2e-6 * sc.diameter
+    grown = sorted(sorted(s.coords) for s in overlap_segments(sc))
+    assert grown[0][0] == pytest.approx((0.2 - rho, -0.5), abs=1e-12)
     r = recognizable_region(sc, model="partial")
     # in an open room every placement outside both targets sees a non-overlap part
     both = sc.target_at(0, 0, 0).union(sc.target_at(1.2, 0, 0))

@@ -283,3 +283,67 @@ def test_eps_pos_larger_than_room():
         complete_region(s, target_at=(2, 1.5, 0), eps_pos=20.0)
     with pytest.raises(ValueError, match="eps_pos"):
         partial_region(s, target_at=(2, 1.5, 0), eps_pos=1e9)
+
+
+# -- sensor accuracy in confusability ---------------------------------------------------------
+
+RECT = [[-1, -0.5], [1, -0.5], [1, 0.5], [-1, 0.5]]
+SLIT = [
+    [[-10, 2], [0.5, 2], [0.5, 2.5], [-10, 2.5]],
+    [[0.7, 2], [10, 2], [10, 2.5], [0.7, 2.5]],
+]
+
+
+def slit_scene(h: tuple[float, float], size: float = 0.0, **sensor) -> Scene:
+    def region(x: float, y: float) -> list[list[float]]:
+        if size == 0:
+            return [[x, y]]
+        return [
+            [x - size, y - size],
+            [x + size, y - size],
+            [x + size, y + size],
+            [x - size, y + size],
+        ]
+
+    d = {
+        "name": "slit",
+        "bounds": [[-10, -10], [10, -10], [10, 10], [-10, 10]],
+        "obstacles": SLIT,
+        "target": RECT,
+        "goal": region(0.0, 0.0),
+        "failure": region(*h),
+    }
+    if sensor:
+        d["sensor"] = sensor
+    return Scene.from_dict(d)
+
+
+@pytest.mark.parametrize("size", [0.0, 0.05], ids=["points (5.1)", "polygons (5.2)"])
+def test_slit_with_rounded_h_is_confusable(size):
+    """Through the slit only the overlapping top edges of A_g and A_h are seen: not
+    recognizable.  H written to 6 decimals (edges collinear to ~4e-7) must not change that."""
+    kw = {} if size == 0 else {"theta": 0.0}
+    # polygons: H sits on top of G (touching), so only the top configurations of G
+    # give top edges collinear with those of H
+    y = 2 * size
+    exact = recognizable_region(slit_scene((1.2, y), size), model="partial", **kw)
+    rounded_scene = slit_scene((1.2000004, y + 0.0000004), size)
+    rounded = recognizable_region(rounded_scene, model="partial", **kw)
+    above = shapely.box(-10, 2.5, 10, 10)
+    assert shapely.intersection(exact, above).area < 1e-9
+    assert shapely.intersection(rounded, above).area < 1e-9
+    assert rounded.area == pytest.approx(exact.area, rel=1e-3)
+    # a sensor declared exact to the last bit tells them apart again (the old answer)
+    bitexact = slit_scene((1.2000004, y + 0.0000004), size, range_acc=0.0, normal_acc_deg=0.0)
+    r = recognizable_region(bitexact, model="partial", **kw)
+    assert shapely.intersection(r, above).area > 0.1
+
+
+def test_accuracy_fields_validated_and_scaled():
+    with pytest.raises(SceneError, match="range_acc"):
+        Scene.from_dict({**ROOM, "sensor": {"range_acc": -1}})
+    with pytest.raises(SceneError, match="normal_acc_deg"):
+        Scene.from_dict({**ROOM, "sensor": {"normal_acc_deg": 90}})
+    s = Scene.from_dict({**ROOM, "sensor": {"range_acc": 0.016}})
+    assert s.range_acc == 0.016 and s.local.range_acc == 0.016 / s.frame.scale
+    assert Scene.from_dict(ROOM).range_acc == pytest.approx(1e-6 * ROOM_DIAM)
