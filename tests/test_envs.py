@@ -312,7 +312,7 @@ def test_target_reflects_beams():
     # put the robot in the recognizable region and compare with a scan of the empty scene
     p = w.region.representative_point()
     env.pose = (p.x, p.y, 0.0)
-    env._read_sensor(env.pose)
+    env.batch.sense(np.array([0]))
     with_target = env.scan[0].copy()
     empty = env.sensor.read(env.pose, w.seg_set)[0]
     assert (with_target < empty - 1e-9).any()

@@ -38,10 +38,12 @@ from gymnasium import spaces
 from .sensor import RangeSensor
 
 if TYPE_CHECKING:  # pragma: no cover
+    from .sim import BatchSim
     from .world import World
 
 __all__ = [
     "OBS_TYPES",
+    "grid_cells",
     "PlacementGridObs",
     "PlacementVectorObs",
     "RobotGridObs",
@@ -50,6 +52,21 @@ __all__ = [
 ]
 
 OBS_TYPES = ("vector", "grid")
+
+
+def grid_cells(sim: BatchSim, idx: np.ndarray, size: int, x, y) -> tuple[np.ndarray, np.ndarray]:
+    """Row and column of points ``(x, y)`` (``(k,)`` or ``(k, B)``) in the ``size`` grid of
+    each sub-environment's world (:meth:`World.grid_transform`), clipped to the grid."""
+    lo, hi = sim.lo[idx], sim.hi[idx]
+    span = (hi - lo).max(axis=1)
+    scale = size / span
+    ox = lo[:, 0] - 0.5 * (span - (hi[:, 0] - lo[:, 0]))
+    oy = lo[:, 1] - 0.5 * (span - (hi[:, 1] - lo[:, 1]))
+    if np.ndim(x) == 2:
+        scale, ox, oy = scale[:, None], ox[:, None], oy[:, None]
+    j = np.clip(((x - ox) * scale).astype(int), 0, size - 1)
+    i = np.clip((size - (y - oy) * scale).astype(int), 0, size - 1)
+    return i, j
 
 
 def _scaled(world: World, x: float, y: float) -> tuple[float, float]:
@@ -64,46 +81,29 @@ class RobotVectorObs:
         low = np.concatenate([-np.ones(8), np.zeros(n), -np.ones(2 * n)]).astype(np.float32)
         high = np.ones(8 + 3 * n, dtype=np.float32)
         self.space = spaces.Box(low, high, dtype=np.float32)
-        self._low, self._high = low, high
 
-    def __call__(self, world: World, pose, scan) -> np.ndarray:
-        x, y, psi = pose
-        dist, nrm = scan[0], scan[1]
-        c, s = math.cos(psi), math.sin(psi)
-        k = world._cache.get("obs_consts")
-        if k is None:
-            k = world._cache["obs_consts"] = (
-                float(world.lo[0]),
-                float(world.lo[1]),
-                2.0 / float(world.hi[0] - world.lo[0]),
-                2.0 / float(world.hi[1] - world.lo[1]),
-                1.0 / world.diameter,
-                1.0 / world.reach,
-                float(world.goal_center[0]),
-                float(world.goal_center[1]),
-                float(world.failure_center[0]),
-                float(world.failure_center[1]),
-            )
-        lx, ly, sx, sy, inv, inv_reach, Gx, Gy, Hx, Hy = k
-        gx, gy, hx, hy = Gx - x, Gy - y, Hx - x, Hy - y
-        px = (x - lx) * sx - 1.0
-        py = (y - ly) * sy - 1.0
-        head = np.array(
-            [
-                -1.0 if px < -1.0 else (1.0 if px > 1.0 else px),
-                -1.0 if py < -1.0 else (1.0 if py > 1.0 else py),
-                c,
-                s,
-                (c * gx + s * gy) * inv,
-                (-s * gx + c * gy) * inv,
-                (c * hx + s * hy) * inv,
-                (-s * hx + c * hy) * inv,
-            ]
-        )
-        nr = (nrm @ np.array([[c, -s], [s, c]])).T.ravel()  # robot-frame x's, then y's
+    def __call__(self, sim: BatchSim, idx: np.ndarray) -> np.ndarray:
+        x, y, psi = sim.x[idx], sim.y[idx], sim.psi[idx]
+        c, s = np.cos(psi), np.sin(psi)
+        lo, hi = sim.lo[idx], sim.hi[idx]
+        inv = 1.0 / sim.diameter[idx]
+        out = np.empty((len(idx), 8 + 3 * self.n))
+        out[:, 0] = 2 * (x - lo[:, 0]) / (hi[:, 0] - lo[:, 0]) - 1.0
+        out[:, 1] = 2 * (y - lo[:, 1]) / (hi[:, 1] - lo[:, 1]) - 1.0
+        np.clip(out[:, :2], -1.0, 1.0, out=out[:, :2])
+        out[:, 2], out[:, 3] = c, s
+        for k, ctr in ((4, sim.goal_c[idx]), (6, sim.fail_c[idx])):
+            gx, gy = ctr[:, 0] - x, ctr[:, 1] - y
+            out[:, k] = (c * gx + s * gy) * inv
+            out[:, k + 1] = (-s * gx + c * gy) * inv
+        n = self.n
+        out[:, 8 : 8 + n] = sim.scan_dist[idx] / sim.reach[idx, None]
+        nrm = sim.scan_normal[idx]  # robot-frame x's, then y's
+        out[:, 8 + n : 8 + 2 * n] = c[:, None] * nrm[..., 0] + s[:, None] * nrm[..., 1]
+        out[:, 8 + 2 * n :] = -s[:, None] * nrm[..., 0] + c[:, None] * nrm[..., 1]
         # every entry is within its bounds up to rounding of order 1e-16, which the float32
         # conversion absorbs (values within 2**-25 of +-1 round to +-1)
-        return np.concatenate([head, dist * inv_reach, nr]).astype(np.float32)
+        return out.astype(np.float32)
 
 
 class RobotGridObs:
@@ -115,39 +115,51 @@ class RobotGridObs:
         self.size = int(grid_size)
         self.space = spaces.Box(0, 255, (self.channels, self.size, self.size), dtype=np.uint8)
 
-    def __call__(self, world: World, pose, scan) -> np.ndarray:
-        size = self.size
-        out = np.zeros((self.channels, size, size), dtype=np.uint8)
-        out[:3] = world.raster(size)
-        x, y, psi = pose
-        cell = size / float(max(world.hi - world.lo))
-        i, j = world.to_cell(size, x, y)
-        hx, hy = x + 2 * math.cos(psi) / cell, y + 2 * math.sin(psi) / cell
-        hi_, hj = world.to_cell(size, hx, hy)
-        out[3, hi_, hj] = 128
-        out[3, i, j] = 255
-        dist, hit = scan[0], scan[2]
+    def __call__(self, sim: BatchSim, idx: np.ndarray) -> np.ndarray:
+        size, k = self.size, len(idx)
+        out = np.zeros((k, self.channels, size, size), dtype=np.uint8)
+        out[:, :3] = _rasters(sim, idx, size)
+        x, y, psi = sim.x[idx], sim.y[idx], sim.psi[idx]
+        cell = size / (sim.hi[idx] - sim.lo[idx]).max(axis=1)
+        rows = np.arange(k)
+        i, j = grid_cells(sim, idx, size, x, y)
+        hi_, hj = grid_cells(sim, idx, size, x + 2 * np.cos(psi) / cell, y + 2 * np.sin(psi) / cell)
+        out[rows, 3, hi_, hj] = 128
+        out[rows, 3, i, j] = 255
+        hit = sim.scan_hit[idx]
         if hit.any():
-            ang = scan[3][hit]
-            px = x + dist[hit] * np.cos(ang)
-            py = y + dist[hit] * np.sin(ang)
-            ii, jj = world.to_cell(size, px, py)
-            out[4, ii, jj] = 255
+            d, ang = sim.scan_dist[idx], sim.scan_ang[idx]
+            ii, jj = grid_cells(
+                sim, idx, size, x[:, None] + d * np.cos(ang), y[:, None] + d * np.sin(ang)
+            )
+            r = np.broadcast_to(rows[:, None], hit.shape)
+            out[r[hit], 4, ii[hit], jj[hit]] = 255
         return out
+
+
+def _rasters(sim: BatchSim, idx: np.ndarray, size: int) -> np.ndarray:
+    worlds = [sim.worlds[i] for i in idx.tolist()]
+    first = worlds[0]
+    if all(w is first for w in worlds):
+        return first.raster(size)[None]
+    return np.stack([w.raster(size) for w in worlds])
 
 
 class PlacementVectorObs:
     def __init__(self, n_beams: int, grid_size: int = 64) -> None:
         self.n = n_beams
-        self.scanner = RangeSensor(n_beams, 2 * math.pi, 1.0)
         low = np.concatenate([-np.ones(4), np.zeros(4 + 2 * n_beams)]).astype(np.float32)
         self.space = spaces.Box(low, np.ones(8 + 2 * n_beams, dtype=np.float32), dtype=np.float32)
 
-    def __call__(self, world: World, pose=None, scan=None) -> np.ndarray:
+    def __call__(self, sim: BatchSim, idx: np.ndarray) -> np.ndarray:
+        return np.stack([self.of_world(sim.worlds[i]) for i in idx.tolist()])
+
+    def of_world(self, world: World) -> np.ndarray:
+        """The (constant) observation of one world, computed once."""
         key = f"placement_vec{self.n}"
         cached = world._cache.get(key)
         if cached is not None:
-            return cached.copy()
+            return cached
         span = world.hi - world.lo
         out = []
         for g in (world.goal_center, world.failure_center):
@@ -161,7 +173,7 @@ class PlacementVectorObs:
             out.extend(d / world.diameter)
         arr = np.clip(np.asarray(out), self.space.low, self.space.high).astype(np.float32)
         world._cache[key] = arr
-        return arr.copy()
+        return arr
 
 
 class PlacementGridObs:
@@ -173,8 +185,8 @@ class PlacementGridObs:
         self.size = int(grid_size)
         self.space = spaces.Box(0, 255, (self.channels, self.size, self.size), dtype=np.uint8)
 
-    def __call__(self, world: World, pose=None, scan=None) -> np.ndarray:
-        return world.raster(self.size).copy()
+    def __call__(self, sim: BatchSim, idx: np.ndarray) -> np.ndarray:
+        return np.broadcast_to(_rasters(sim, idx, self.size), (len(idx), *self.space.shape)).copy()
 
 
 def make_observation(kind: str, obs_type: str, n_beams: int, grid_size: int):

@@ -1,4 +1,4 @@
-"""The point-and-shoot range sensor of the paper (section 2), vectorised.
+"""The point-and-shoot range sensor of the paper (section 2), batched.
 
 A sensor at pose ``(x, y, psi)`` casts a fan of ``n_beams`` beams spread evenly
 over the field of view ``fov`` (radians) centred on ``psi``; with a full 360-degree
@@ -10,8 +10,11 @@ the sensor.  A beam that hits nothing within ``max_range`` returns
 
 Optional Gaussian noise (standard deviation ``noise``, scene units) is added to
 the hit distances, which are then clipped to ``[0, max_range]``; normals are
-noise-free.  All work is one broadcast over beams x segments (no per-beam Python
-loop): about 15 numpy operations on ``(n_beams, n_segments)`` arrays.
+noise-free.
+
+:func:`cast_batch` is the one implementation: N sensors x B beams x M segments in one
+broadcast (about 15 numpy operations on ``(N, B, M)`` arrays, no Python loop); the
+one-sensor helpers :func:`cast_rays` and :meth:`RangeSensor.read` call it with N = 1.
 """
 
 from __future__ import annotations
@@ -20,111 +23,94 @@ import math
 
 import numpy as np
 
-__all__ = ["RangeSensor", "Segments", "cast_rays"]
+from .segments import Segments
 
-
-class Segments:
-    """An ``(S, 4)`` segment array with the per-segment constants that the ray cast, the
-    collision sweep and the clearance query use, laid out for a few matrix products."""
-
-    __slots__ = ("segs", "x0", "y0", "ex", "ey", "nx", "ny", "L2", "inv_L2", "n", "M", "Q", "N")
-
-    def __init__(self, segs: np.ndarray, normals: np.ndarray | None = None) -> None:
-        segs = np.ascontiguousarray(segs, dtype=np.float64).reshape(-1, 4)
-        self.segs = segs
-        self.n = segs.shape[0]
-        self.x0 = segs[:, 0].copy()
-        self.y0 = segs[:, 1].copy()
-        self.ex = segs[:, 2] - segs[:, 0]
-        self.ey = segs[:, 3] - segs[:, 1]
-        self.L2 = self.ex * self.ex + self.ey * self.ey
-        self.inv_L2 = 1.0 / np.where(self.L2 > 0, self.L2, 1.0)
-        if normals is None:
-            L = np.sqrt(np.where(self.L2 > 0, self.L2, 1.0))
-            normals = np.stack([-self.ey / L, self.ex / L], axis=1)
-        self.N = np.ascontiguousarray(normals, dtype=np.float64).reshape(-1, 2)
-        self.nx = self.N[:, 0].copy()
-        self.ny = self.N[:, 1].copy()
-        x0, y0, ex, ey, n = self.x0, self.y0, self.ex, self.ey, self.n
-        # [dx, dy, dx*oy - dy*ox] @ M = [cross(d, e) | cross(a - o, d)]
-        M = np.zeros((3, 2 * n))
-        M[0, :n], M[0, n:] = ey, -y0
-        M[1, :n], M[1, n:] = -ex, x0
-        M[2, n:] = 1.0
-        self.M = M
-        # [1, ox, oy] @ Q = [cross(a - o, e) | n . (o - a)]
-        Q = np.empty((3, 2 * n))
-        Q[0, :n], Q[0, n:] = x0 * ey - y0 * ex, -(self.nx * x0 + self.ny * y0)
-        Q[1, :n], Q[1, n:] = -ey, self.nx
-        Q[2, :n], Q[2, n:] = ex, self.ny
-        self.Q = Q
-
-    def __getstate__(self):
-        return {"segs": self.segs, "normals": self.N}
-
-    def __setstate__(self, st):
-        self.__init__(st["segs"], st["normals"])
-
-    def __add__(self, other: Segments) -> Segments:
-        return Segments(np.concatenate([self.segs, other.segs]), np.concatenate([self.N, other.N]))
-
-    def clearance(self, x: float, y: float) -> float:
-        """Distance from ``(x, y)`` to the nearest segment (``inf`` if there are none)."""
-        if not self.n:
-            return math.inf
-        px = x - self.x0
-        py = y - self.y0
-        t = (px * self.ex + py * self.ey) * self.inv_L2
-        np.minimum(t, 1.0, out=t)
-        np.maximum(t, 0.0, out=t)
-        px -= t * self.ex
-        py -= t * self.ey
-        return math.sqrt(float(np.min(px * px + py * py)))
-
+__all__ = ["RangeSensor", "Segments", "cast_batch", "cast_rays"]
 
 _ERR = {"divide": "ignore", "invalid": "ignore", "over": "ignore"}
+
+
+def _seg3(a: np.ndarray) -> np.ndarray:
+    """``(M,)`` -> ``(1, 1, M)``; ``(N, M)`` -> ``(N, 1, M)`` (broadcast against beams)."""
+    return a[None, None, :] if a.ndim == 1 else a[:, None, :]
+
+
+def cast_batch(
+    ox: np.ndarray, oy: np.ndarray, ang: np.ndarray, S, max_range
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """First hits of N fans of rays against segment sets.
+
+    ``ox, oy``: ``(N,)`` ray origins (world frame); ``ang``: ``(N, B)`` ray directions
+    (radians, world frame); ``S``: a :class:`~.segments.Segments` shared by all N, or
+    :class:`~.segments.SegmentRows`-like ``(N, M)`` arrays, one set per origin;
+    ``max_range``: scalar or ``(N,)``.
+
+    Returns ``dist (N, B)`` (scene units, clipped at ``max_range``), ``normal (N, B, 2)``
+    (unit, world frame, facing the ray origin; zero where nothing was hit) and
+    ``hit (N, B)`` (bool)."""
+    ox = np.asarray(ox, dtype=np.float64)
+    oy = np.asarray(oy, dtype=np.float64)
+    n, b = ang.shape
+    mr = np.broadcast_to(np.asarray(max_range, dtype=np.float64), (n,))
+    if S.x0.shape[-1] == 0:
+        return np.repeat(mr[:, None], b, 1), np.zeros((n, b, 2)), np.zeros((n, b), bool)
+    dx = np.cos(ang)[:, :, None]
+    dy = np.sin(ang)[:, :, None]
+    ax = S.x0 - ox[:, None]  # (N, M): a - o
+    ay = S.y0 - oy[:, None]
+    ex, ey = _seg3(S.ex), _seg3(S.ey)
+    tnum = (ax * S.ey - ay * S.ex)[:, None, :]  # cross(a - o, e)
+    ax3, ay3 = ax[:, None, :], ay[:, None, :]
+    with np.errstate(**_ERR):
+        inv = 1.0 / (dx * ey - dy * ex)  # 1 / cross(d, e)
+        t = tnum * inv
+        u = (ax3 * dy - ay3 * dx) * inv  # cross(a - o, d) / cross(d, e)
+    w = np.minimum(u, 1.0 - u)
+    np.minimum(w, t, out=w)
+    t[~(w >= 0.0)] = np.inf  # also NaN (parallel, collinear or padding segments)
+    idx = t.argmin(axis=2)  # (N, B)
+    r = _rows(n)
+    dist = t[r, _cols(b), idx]
+    hit = dist <= mr[:, None]
+    np.minimum(dist, mr[:, None], out=dist)
+    # normal at the hit segment, turned to face the origin
+    if S.nx.ndim == 1:
+        nx, ny = S.nx[idx], S.ny[idx]
+    else:
+        nx, ny = S.nx[r, idx], S.ny[r, idx]
+    side = -(nx * ax[r, idx] + ny * ay[r, idx])
+    sgn = np.sign(side) * hit
+    return dist, np.stack([nx * sgn, ny * sgn], axis=2), hit
+
+
+_ROWS: dict[int, np.ndarray] = {}
+_COLS: dict[int, np.ndarray] = {}
+
+
+def _rows(n: int) -> np.ndarray:
+    """``arange(n)[:, None]`` (cached)."""
+    r = _ROWS.get(n)
+    if r is None:
+        r = _ROWS[n] = np.arange(n)[:, None]
+    return r
+
+
+def _cols(b: int) -> np.ndarray:
+    c = _COLS.get(b)
+    if c is None:
+        c = _COLS[b] = np.arange(b)[None, :]
+    return c
 
 
 def cast_rays(
     ox: float, oy: float, psi: float, dirs: np.ndarray, S: Segments, max_range: float
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """First hits of the rays from ``(ox, oy)`` with directions ``dirs`` (``(n, 2)`` unit
-    vectors in the sensor frame) turned by ``psi``, against the segments ``S``.
-
-    Returns ``dist (n,)``, ``normal (n, 2)`` (facing the ray origin; zero where nothing was
-    hit) and ``hit (n,)`` (bool).  Hits are clipped at ``max_range``.  About 20 numpy calls
-    on ``(n, S)`` arrays (three of them small matrix products)."""
-    n = dirs.shape[0]
-    S_n = S.n
-    if not S_n:
-        return np.full(n, max_range), np.zeros((n, 2)), np.zeros(n, dtype=bool)
-    c, s = math.cos(psi), math.sin(psi)
-    R3 = np.array([[c, s, c * oy - s * ox], [-s, c, -s * oy - c * ox]])
-    DM = (dirs @ R3) @ S.M  # (n, 2S): denominators | u-numerators
-    V = np.array([1.0, ox, oy]) @ S.Q  # (2S,): t-numerators | side of each segment
-    with np.errstate(**_ERR):
-        inv = 1.0 / DM[:, :S_n]
-        t = V[:S_n] * inv
-        u = DM[:, S_n:] * inv
-    w = np.minimum(u, 1.0 - u)
-    np.minimum(w, t, out=w)
-    t[~(w >= 0.0)] = np.inf  # also NaN (collinear ray and segment)
-    idx = t.argmin(axis=1)
-    dist = t[_rows(n), idx]
-    hit = dist <= max_range
-    np.minimum(dist, max_range, out=dist)
-    sgn = np.sign(V[S_n:][idx]) * hit
-    return dist, S.N[idx] * sgn[:, None], hit
-
-
-_ROWS: dict[int, np.ndarray] = {}
-
-
-def _rows(n: int) -> np.ndarray:
-    r = _ROWS.get(n)
-    if r is None:
-        r = _ROWS[n] = np.arange(n)
-    return r
+    """One sensor: rays from ``(ox, oy)`` with directions ``dirs`` (``(n, 2)`` unit vectors
+    in the sensor frame) turned by ``psi``.  Returns ``dist (n,)``, ``normal (n, 2)``,
+    ``hit (n,)`` as :func:`cast_batch` for N = 1."""
+    ang = (np.arctan2(dirs[:, 1], dirs[:, 0]) + psi)[None, :]
+    d, nrm, hit = cast_batch(np.array([ox]), np.array([oy]), ang, S, max_range)
+    return d[0], nrm[0], hit[0]
 
 
 class RangeSensor:
@@ -141,12 +127,7 @@ class RangeSensor:
         self.fov = float(fov)
         self.max_range = float(max_range)
         self.noise = float(noise)
-        if self.fov >= 2 * math.pi - 1e-12:
-            self.offsets = np.arange(self.n_beams) * (2 * math.pi / self.n_beams) - math.pi
-        elif self.n_beams == 1:
-            self.offsets = np.zeros(1)
-        else:
-            self.offsets = np.linspace(-self.fov / 2, self.fov / 2, self.n_beams)
+        self.offsets = beam_offsets(self.n_beams, self.fov)
         self.dirs = np.stack([np.cos(self.offsets), np.sin(self.offsets)], axis=1)
 
     def beam_angles(self, psi: float) -> np.ndarray:
@@ -159,12 +140,33 @@ class RangeSensor:
         rng: np.random.Generator | None = None,
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """``(dist, normal, hit, angles)`` for the beams at ``pose``; noise from ``rng``."""
-        dist, nrm, hit = cast_rays(pose[0], pose[1], pose[2], self.dirs, segs, self.max_range)
         ang = self.offsets + pose[2]
+        dist, nrm, hit = cast_batch(
+            np.array([pose[0]]), np.array([pose[1]]), ang[None, :], segs, self.max_range
+        )
+        dist, nrm, hit = dist[0], nrm[0], hit[0]
         if self.noise > 0 and rng is not None:
-            dist = np.clip(
-                dist + np.where(hit, rng.normal(0.0, self.noise, dist.shape), 0.0),
-                0.0,
-                self.max_range,
-            )
+            z = rng.standard_normal(dist.shape)
+            dist = add_noise(dist, hit, z, self.noise, self.max_range)
         return dist, nrm, hit, ang
+
+
+def beam_offsets(n_beams: int, fov: float) -> np.ndarray:
+    """Beam angles relative to the aim (radians): evenly over ``fov``, or ``2 pi / n``
+    apart (none duplicated) for a full circle."""
+    if fov >= 2 * math.pi - 1e-12:
+        return np.arange(n_beams) * (2 * math.pi / n_beams) - math.pi
+    if n_beams == 1:
+        return np.zeros(1)
+    return np.linspace(-fov / 2, fov / 2, n_beams)
+
+
+def add_noise(dist, hit, z, noise, max_range):
+    """``dist + noise * z`` on the beams that hit, clipped to ``[0, max_range]``."""
+    mr = np.asarray(max_range)
+    if mr.ndim:
+        mr = mr[:, None]
+    return np.clip(dist + np.where(hit, noise * z, 0.0), 0.0, mr)
+
+
+__all__ += ["add_noise", "beam_offsets"]

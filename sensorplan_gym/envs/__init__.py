@@ -1,8 +1,17 @@
 """The three environments; see each module's docstring for spaces and rewards."""
 
-from .base import SensorPlanEnv
-from .navigate import NavigateEnv
-from .placement import PlacementEnv
-from .recognize import RecognizeEnv
+from .base import SensorPlanBatch, SensorPlanEnv
+from .navigate import NavigateBatch, NavigateEnv
+from .placement import PlacementBatch, PlacementEnv
+from .recognize import RecognizeBatch, RecognizeEnv
 
-__all__ = ["NavigateEnv", "PlacementEnv", "RecognizeEnv", "SensorPlanEnv"]
+__all__ = [
+    "NavigateBatch",
+    "NavigateEnv",
+    "PlacementBatch",
+    "PlacementEnv",
+    "RecognizeBatch",
+    "RecognizeEnv",
+    "SensorPlanBatch",
+    "SensorPlanEnv",
+]

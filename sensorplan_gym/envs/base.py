@@ -1,14 +1,21 @@
-"""Base class of the sensor-planning environments: configuration, scene handling, seeding,
-action checking, sensing and rendering shared by Placement, Navigate and Recognize.
+"""Base classes of the sensor-planning environments.
 
-Common keyword arguments (``gym.make(id, **kwargs)``)
------------------------------------------------------
+Each task (Placement, Navigate, Recognize) is written once, as a *batch* class
+(:class:`SensorPlanBatch`, a :class:`~sensorplan_gym.core.sim.BatchSim`) whose ``reset_envs``
+and ``step_envs`` advance any subset of N sub-environments with array operations.  The
+Gymnasium single env :class:`SensorPlanEnv` is the batch of one; the native vector env
+(:mod:`sensorplan_gym.envs.vector`) is the batch of N.  There is no second implementation.
+
+Common keyword arguments (``gym.make(id, **kwargs)`` and ``gym.make_vec(id, **kwargs)``)
+----------------------------------------------------------------------------------------
 scene : str | path | dict | geometry.Scene, default ``"lab"``
     A bundled scene name (``lab``, ``edr``, ``corridor``, ``warehouse``), a path to a scene
-    JSON file in the pinned format, or ``"random"``: a new procedural scene
-    (:func:`geometry.generate.random_scene`) on every reset, drawn from ``self.np_random``.
-    Random scenes whose region is empty, unreachable from the start, or that contain the
-    start are re-drawn (deterministically, up to ``max_scene_tries`` times).
+    JSON file in the pinned format, or ``"random"``: at every reset a scene drawn (with the
+    env's ``np_random``) from a seeded pool of procedural scenes
+    (:class:`~sensorplan_gym.core.pool.ScenePool`; scenes whose region is empty, unreachable
+    from the start, or that contain the start are re-drawn when the pool is built).
+scene_pool_size : int, default 64 -- scenes in the ``"random"`` pool.
+scene_pool_seed : int, default 0 -- the pool's seed (disjoint seeds: disjoint splits).
 model : ``"complete"`` | ``"partial"`` -- the visibility model of the recognizable region.
 motion : ``"stationary"`` | ``"translating"`` | ``"rotating"`` (see
     :mod:`sensorplan_gym.core.world`).  Unsupported combinations raise
@@ -37,6 +44,7 @@ recognizing for every executed pose.
 
 from __future__ import annotations
 
+import functools
 import math
 from typing import Any
 
@@ -44,26 +52,83 @@ import gymnasium as gym
 import numpy as np
 import shapely
 
-from geometry import Scene
-
 from ..core.observations import make_observation
+from ..core.pool import FixedScene, shared_pool
 from ..core.rendering import HumanViewer, Renderer
 from ..core.sensor import RangeSensor
-from ..core.world import World, WorldConfig, get_world, load_scene, sweep
+from ..core.sim import BLOCK, BatchSim
+from ..core.world import World, WorldConfig, get_world, load_scene
 
-__all__ = ["SensorPlanEnv"]
+__all__ = ["RobotBatch", "SensorPlanBatch", "SensorPlanEnv", "check_actions"]
+
+Start = tuple[float, float, float]
 
 
-class SensorPlanEnv(gym.Env):
-    """Shared machinery; subclasses define ``obs_kind``, ``action_space`` and the hooks
-    ``_reset_episode``, ``_step`` and ``_scene_ok``."""
+def _start_pose(world: World, rng: np.random.Generator, needs_start: bool) -> Start:
+    s = world.scene.start
+    if s is not None and world.in_free_space(s[0], s[1]):
+        return (float(s[0]), float(s[1]), float(s[2]))
+    if not needs_start:
+        return (float(world.goal_center[0]), float(world.goal_center[1]), 0.0)
+    # sample a free start that does not recognize
+    for _ in range(2000):
+        x = rng.uniform(world.lo[0], world.hi[0])
+        y = rng.uniform(world.lo[1], world.hi[1])
+        if world.in_free_space(x, y) and not world.in_region(x, y):
+            return (float(x), float(y), float(rng.uniform(-math.pi, math.pi)))
+    raise ValueError(f"scene {world.scene.name!r}: found no free start outside the region")
 
-    metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 10}
+
+def _scene_problem(world: World, start: Start, needs_start: bool) -> str | None:
+    """Why this world cannot host an episode (``None`` if it can)."""
+    if world.region.is_empty:
+        return "the recognizable region is empty under this configuration"
+    if not needs_start:
+        return None
+    if world.reachable_region(start[:2]).is_empty:
+        return "the recognizable region is not reachable from the start"
+    if world.recognizing(*start):
+        return "the start pose already recognizes G vs H"
+    return None
+
+
+def _check(world: World, rng: np.random.Generator, needs_start: bool):
+    try:
+        start = _start_pose(world, rng, needs_start)
+    except ValueError as e:
+        return None, str(e)
+    return start, _scene_problem(world, start, needs_start)
+
+
+def check_actions(actions: Any, shape: tuple[int, ...]) -> np.ndarray:
+    """Validate and clip a batch of actions: an array of ``shape`` (``(k, d)``); a wrong shape
+    or non-finite values raise ``ValueError``; values outside [-1, 1] are clipped."""
+    try:
+        a = np.asarray(actions, dtype=np.float64)
+    except (TypeError, ValueError) as e:
+        raise ValueError(
+            f"action must be a numeric array of shape {shape[1:]}, got {actions!r}"
+        ) from e
+    if a.shape != shape:
+        raise ValueError(f"action must have shape {shape[1:]}, got shape {a.shape[1:]}")
+    if not np.isfinite(a).all():
+        raise ValueError(f"action contains NaN or infinite values: {a.tolist()}")
+    return np.clip(a, -1.0, 1.0)
+
+
+class SensorPlanBatch(BatchSim):
+    """A task over N sub-environments; subclasses define ``obs_kind``, ``action_dim`` and the
+    hooks ``_reset_one`` (Python, per resetting sub-environment: draws from its generator),
+    ``_after_reset`` and ``step_envs`` (arrays over the stepping sub-environments)."""
+
     obs_kind = "robot"
     needs_start = True
+    action_dim = 3
+    horizon = 200
 
     def __init__(
         self,
+        n: int,
         scene: str | Any = "lab",
         *,
         model: str = "complete",
@@ -79,15 +144,10 @@ class SensorPlanEnv(gym.Env):
         robot_radius: float = 0.0,
         random_scene_kwargs: dict | None = None,
         max_scene_tries: int = 25,
-        render_mode: str | None = None,
+        scene_pool_size: int = 64,
+        scene_pool_seed: int = 0,
+        max_steps: int | None = None,
     ) -> None:
-        super().__init__()
-        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
-            raise ValueError(
-                f"render_mode must be None or one of {self.metadata['render_modes']}, "
-                f"got {render_mode!r}"
-            )
-        self.render_mode = render_mode
         for name, v in (
             ("eps_pos", eps_pos),
             ("eps_aim", eps_aim),
@@ -100,6 +160,9 @@ class SensorPlanEnv(gym.Env):
             raise ValueError(f"noise must be a finite non-negative number, got {noise!r}")
         if not isinstance(n_beams, (int, np.integer)) or n_beams < 1:
             raise ValueError(f"n_beams must be a positive integer, got {n_beams!r}")
+        if max_steps is not None and (not isinstance(max_steps, int) or max_steps < 1):
+            raise ValueError(f"max_steps must be a positive integer or None, got {max_steps!r}")
+        self.max_steps = int(max_steps) if max_steps is not None else self.horizon
         self.cfg = WorldConfig(
             model=model,
             motion=motion,
@@ -109,115 +172,306 @@ class SensorPlanEnv(gym.Env):
             max_range=None if max_range is None else float(max_range),
             robot_radius=float(robot_radius),
         ).validate()
-        self.n_beams = int(n_beams)
-        self.noise = float(noise)
+        super().__init__(n, n_beams, noise, robot_radius)
         self.obs_type = obs_type
-        self.max_scene_tries = int(max_scene_tries)
-        self.random_scene_kwargs = dict(random_scene_kwargs or {})
-        self._obs = make_observation(self.obs_kind, obs_type, self.n_beams, grid_size)
-        self.observation_space = self._obs.space
-
+        self.obs = make_observation(self.obs_kind, obs_type, self.n_beams, grid_size)
+        self.single_observation_space = self.obs.space
+        self.single_action_space = gym.spaces.Box(-1.0, 1.0, (self.action_dim,), np.float32)
+        self.elapsed = np.zeros(self.n, dtype=np.int64)
         self.random = isinstance(scene, str) and scene == "random"
+        check = functools.partial(_check, needs_start=self.needs_start)
         if self.random:
-            try:
-                from geometry.generate import random_scene  # noqa: F401
-            except ImportError as e:  # pragma: no cover - generate.py ships with geometry
-                raise ImportError("scene='random' needs geometry.generate.random_scene") from e
-            # probe once (fixed seed) so unsupported configurations fail here, not at reset
-            self.world, self.start = self._draw_world(np.random.default_rng(0))
+            self.source = shared_pool(
+                self.cfg,
+                check,
+                "start" if self.needs_start else "nostart",
+                size=scene_pool_size,
+                seed=scene_pool_seed,
+                scene_kwargs=dict(random_scene_kwargs or {}),
+                max_tries=max_scene_tries,
+            )
+            world, start = self.source.get(0)  # unsupported configurations fail here
         else:
-            self._scene = load_scene(scene)
-            self.world = get_world(self._scene, self.cfg)
-            self.start = self._start_pose(self.world, np.random.default_rng(0))
-            problem = self._scene_problem(self.world, self.start)
+            sc = load_scene(scene)
+            world = get_world(sc, self.cfg)
+            start, problem = check(world, np.random.default_rng(0))
             if problem:
-                raise ValueError(
-                    f"scene {self._scene.name!r} unusable for {type(self).__name__}: {problem}"
-                )
+                raise ValueError(f"scene {sc.name!r} unusable for {self.task_name}: {problem}")
+            self.source = FixedScene(world, start)
+        self.starts = np.tile(np.asarray(start, dtype=np.float64), (self.n, 1))
+        for i in range(self.n):
+            self.load_world(i, world)
+
+    @property
+    def task_name(self) -> str:
+        return type(self).__name__.replace("Batch", "Env")
+
+    def sensor(self, i: int = 0) -> RangeSensor:
+        """The range sensor of sub-environment ``i`` (beams, field of view, reach, noise)."""
+        return RangeSensor(self.n_beams, float(self.fov[i]), float(self.reach[i]), self.noise)
+
+    # ---- episodes ---------------------------------------------------------------------
+    def reset_envs(self, idx: np.ndarray, options: dict | None = None) -> None:
+        """Start new episodes in sub-environments ``idx``."""
+        options = options or {}
+        for i in idx.tolist():
+            world, start = self.source.draw(self.rngs[i])
+            self.load_world(i, world)
+            self.starts[i] = start
+            self.elapsed[i] = 0
+            self._reset_one(i, options)
+        self._after_reset(idx)
+
+    def _reset_one(self, i: int, options: dict) -> None:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def _after_reset(self, idx: np.ndarray) -> None:
+        pass
+
+    def step_envs(self, act: np.ndarray, idx: np.ndarray) -> tuple[np.ndarray, ...]:
+        """Advance sub-environments ``idx`` by the (checked) actions ``act`` ``(k, d)``.
+        Returns ``(reward, terminated, truncated, info)``: ``(k,)`` arrays and a dict of
+        info columns ``name -> (values (k, ...), mask (k,) or None)``."""
+        raise NotImplementedError  # pragma: no cover - abstract
+
+    def observe(self, idx: np.ndarray) -> np.ndarray:
+        """Observations ``(k, *single_observation_space.shape)`` of sub-environments ``idx``."""
+        return self.obs(self, idx)
+
+    def reset_info(self, idx: np.ndarray) -> dict[str, tuple[np.ndarray, np.ndarray | None]]:
+        """Info columns at reset."""
+        raise NotImplementedError  # pragma: no cover - abstract
+
+    def render_state(self, i: int) -> dict[str, Any]:
+        """What the renderer draws for sub-environment ``i``."""
+        has = bool(self.has_scan[i])
+        pose = self.pose(i) if self._has_pose(i) else None
+        rec = False
+        if pose is not None:
+            rec = bool(self.query(np.array([i]))[0][0])
+        return {
+            "pose": pose,
+            "sensor_pose": self.sensor_pose(i) if has else pose,
+            "scan": self.scan(i),
+            "recognizing": rec,
+            "title": f"{self.task_name}: {self.worlds[i].scene.name}",
+        }
+
+    def _has_pose(self, i: int) -> bool:
+        return True
+
+
+class RobotBatch(SensorPlanBatch):
+    """A mobile sensor: a disc (or point) robot that drives and turns, with collisions.
+
+    Action ``Box(-1, 1, (k,), float32)`` whose first three components are ``forward``,
+    ``lateral`` (to the left) and ``turn`` (counter-clockwise).  The robot first translates by
+    ``max_speed * (forward, lateral)`` in its current heading's frame, then turns by
+    ``max_turn * turn``.  The translation is swept against walls, obstacles (and the hidden
+    target in Recognize): on contact the robot stops there (it never passes through), and
+    ``info["collided"]`` is True.  Out-of-range components are clipped to [-1, 1].
+
+    ``random_start=True`` draws every episode's start pose from the env's ``np_random``: a
+    uniform free position that does not recognize yet, in a part of the free space from
+    which the recognizable region is reachable, with a uniform heading (default: the
+    scene's ``start``, like TOMMY's fixed start in the paper).
+    """
+
+    def __init__(
+        self,
+        n: int,
+        scene="lab",
+        *,
+        max_speed: float | None = None,
+        max_turn: float = math.pi / 8,
+        random_start: bool = False,
+        **kwargs,
+    ) -> None:
+        if not isinstance(random_start, bool):
+            raise ValueError(f"random_start must be True or False, got {random_start!r}")
+        for name, v in (("max_speed", max_speed), ("max_turn", max_turn)):
+            if v is not None and (
+                not isinstance(v, (int, float)) or not math.isfinite(v) or v <= 0
+            ):
+                raise ValueError(f"{name} must be a positive number, got {v!r}")
+        self.random_start = random_start
+        self._max_speed_cfg = None if max_speed is None else float(max_speed)
+        self.max_turn = float(max_turn)
+        self.collided = np.zeros(n, dtype=bool)
+        super().__init__(n, scene, **kwargs)
+
+    def load_world(self, i: int, world: World, max_speed: float | None = None) -> None:
+        super().load_world(i, world, self._max_speed_cfg)
+
+    def episode_start(self, i: int) -> Start:
+        """The start pose of a new episode of sub-environment ``i`` (see ``random_start``)."""
+        if not self.random_start:
+            return tuple(float(v) for v in self.starts[i])
+        w = self.worlds[i]
+        space = w._cache.get("start_space")
+        if space is None:
+            comps = shapely.get_parts(w.robot_space)
+            space = shapely.union_all(comps[shapely.intersects(comps, w.region)])
+            shapely.prepare(space)
+            w._cache["start_space"] = space
+        rng = self.rngs[i]
+        for _ in range(10_000):
+            x = rng.uniform(w.lo[0], w.hi[0])
+            y = rng.uniform(w.lo[1], w.hi[1])
+            if shapely.contains_xy(space, x, y) and not w.in_region(x, y):
+                return (float(x), float(y), float(rng.uniform(-math.pi, math.pi)))
+        return tuple(float(v) for v in self.starts[i])  # a region covering nearly all free space
+
+    def set_pose(self, i: int, pose) -> None:
+        self.x[i], self.y[i], self.psi[i] = (float(v) for v in pose)
+
+    def _start_from_options(self, i: int, options: dict) -> None:
+        start = options.get("start")
+        if start is not None:
+            x, y, psi = (float(v) for v in start)
+            if not self.worlds[i].in_free_space(x, y):
+                raise ValueError(f"options['start'] = {start!r} is not in the robot's free space")
+            self.set_pose(i, (x, y, psi))
+        else:
+            self.set_pose(i, self.episode_start(i))
+        self.collided[i] = False
+
+    def _after_reset(self, idx: np.ndarray) -> None:
+        self.sense(idx)
+
+    def move(self, act: np.ndarray, idx: np.ndarray) -> np.ndarray:
+        """Drive sub-environments ``idx`` and read their sensors; returns ``collided``."""
+        col = self.drive(act, idx, self.max_turn)
+        self.collided[idx] = col
+        self.sense(idx)
+        return col
+
+
+def _one_row(v: Any) -> Any:
+    """Row 0 of an info column as a plain Python value."""
+    if isinstance(v, np.ndarray):
+        if v.ndim == 0:
+            return v.item()
+        return tuple(float(c) for c in v) if v.dtype.kind == "f" else v.tolist()
+    if isinstance(v, np.generic):
+        return v.item()
+    return v
+
+
+class SensorPlanEnv(gym.Env):
+    """The Gymnasium env of a task: its batch class (``batch_cls``) with N = 1.
+
+    The attributes a planner or a test reads (``world``, ``pose``, ``scan``, ``sensor_pose``,
+    ``start``, ``sensor``, ``max_speed``, ...) are views of sub-environment 0."""
+
+    metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 10}
+    batch_cls: type[SensorPlanBatch] = SensorPlanBatch
+    _ONE = np.zeros(1, dtype=np.intp)
+
+    def __init__(self, scene: str | Any = "lab", *, render_mode: str | None = None, **kwargs):
+        super().__init__()
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ValueError(
+                f"render_mode must be None or one of {self.metadata['render_modes']}, "
+                f"got {render_mode!r}"
+            )
+        self.render_mode = render_mode
+        self.batch = self.batch_cls(1, scene, **kwargs)
+        self.observation_space = self.batch.single_observation_space
+        self.action_space = self.batch.single_action_space
         self._renderer = Renderer() if render_mode is not None else None
         self._viewer = HumanViewer() if render_mode == "human" else None
-        self.pose: tuple[float, float, float] | None = None
-        self.sensor_pose: tuple[float, float, float] | None = None
-        self.scan = None
-        self._target_poly: np.ndarray | None = None
-        self._segs = self.world.seg_set
-        self._make_sensor()
+        self._started = False
 
-    # ---- scenes ---------------------------------------------------------------------------
-    def _make_sensor(self) -> None:
-        w = self.world
-        self.sensor = RangeSensor(self.n_beams, w.fov, w.reach, self.noise)
+    # ---- views of sub-environment 0 ---------------------------------------------------
+    @property
+    def np_random(self) -> np.random.Generator:
+        return self.batch.rngs[0]
 
-    def _start_pose(self, world: World, rng: np.random.Generator) -> tuple[float, float, float]:
-        s = world.scene.start
-        if s is not None and world.in_free_space(s[0], s[1]):
-            return (float(s[0]), float(s[1]), float(s[2]))
-        if not self.needs_start:
-            return (float(world.goal_center[0]), float(world.goal_center[1]), 0.0)
-        # sample a free start that does not recognize
-        for _ in range(2000):
-            x = rng.uniform(world.lo[0], world.hi[0])
-            y = rng.uniform(world.lo[1], world.hi[1])
-            if world.in_free_space(x, y) and not world.in_region(x, y):
-                return (float(x), float(y), float(rng.uniform(-math.pi, math.pi)))
-        raise ValueError(f"scene {world.scene.name!r}: found no free start outside the region")
+    @np_random.setter
+    def np_random(self, value: np.random.Generator) -> None:
+        self.batch.rngs[0] = value
+        self.batch._ptr[0] = BLOCK
 
-    def _scene_problem(self, world: World, start) -> str | None:
-        """Why this world cannot host an episode (``None`` if it can)."""
-        if world.region.is_empty:
-            return "the recognizable region is empty under this configuration"
-        if not self.needs_start:
-            return None
-        if world.reachable_region(start[:2]).is_empty:
-            return "the recognizable region is not reachable from the start"
-        if world.recognizing(*start):
-            return "the start pose already recognizes G vs H"
-        return None
+    @property
+    def world(self) -> World:
+        return self.batch.worlds[0]
 
-    def _draw_world(self, rng: np.random.Generator) -> tuple[World, tuple[float, float, float]]:
-        from geometry.generate import random_scene
+    @property
+    def pose(self) -> tuple[float, float, float] | None:
+        return self.batch.pose(0) if self._started and self.batch._has_pose(0) else None
 
-        last = None
-        for _ in range(self.max_scene_tries):
-            d = random_scene(rng, **self.random_scene_kwargs)
-            scene = Scene.from_dict(d)
-            world = get_world(scene, self.cfg, d)
-            start = self._start_pose(world, rng)
-            last = self._scene_problem(world, start)
-            if last is None:
-                return world, start
-        raise RuntimeError(
-            f"scene='random': no usable scene in {self.max_scene_tries} draws ({last}); "
-            "relax the configuration or raise max_scene_tries"
-        )
+    @pose.setter
+    def pose(self, value) -> None:
+        self.batch.set_pose(0, value)
 
-    # ---- gym API --------------------------------------------------------------------------
+    @property
+    def sensor_pose(self):
+        return self.batch.sensor_pose(0) if self._started and self.batch.has_scan[0] else None
+
+    @property
+    def scan(self):
+        return self.batch.scan(0) if self._started else None
+
+    @property
+    def start(self) -> tuple[float, float, float]:
+        return tuple(float(v) for v in self.batch.starts[0])
+
+    @property
+    def sensor(self) -> RangeSensor:
+        return self.batch.sensor(0)
+
+    @property
+    def max_steps(self) -> int:
+        return self.batch.max_steps
+
+    def __getattr__(self, name: str) -> Any:
+        # task parameters (max_speed, max_turn, random_start, step_cost, ...) live on the batch
+        if name.startswith("__") or name == "batch":
+            raise AttributeError(name)
+        b = self.__dict__.get("batch")
+        if b is None:
+            raise AttributeError(name)
+        v = getattr(b, name)
+        if isinstance(v, np.ndarray) and v.shape[:1] == (1,):
+            return _one_row(v[0])
+        return v
+
+    # ---- gym API ----------------------------------------------------------------------
     def reset(self, *, seed: int | None = None, options: dict | None = None):
-        super().reset(seed=seed)
-        if self.random:
-            self.world, self.start = self._draw_world(self.np_random)
-            self._make_sensor()
-        self._segs = self.world.seg_set
-        self._target_poly = None
-        self._reset_episode(options or {})
-        obs = self._observe()
-        info = self._info()
+        if seed is not None:
+            self.batch.seed_env(0, seed)
+            self._np_random_seed = seed
+        self._np_random = self.batch.rngs[0]
+        self.batch.reset_envs(self._ONE, options)
+        self._started = True
+        obs = self.batch.observe(self._ONE)[0]
+        info = self._info(self.batch.reset_info(self._ONE))
         if self.render_mode == "human":
             self.render()
         return obs, info
 
     def step(self, action):
-        a = self._check_action(action)
-        obs, reward, terminated, truncated, info = self._step(a)
+        a = check_actions(_as_batch(action), (1, *self.action_space.shape))
+        reward, term, trunc, cols = self.batch.step_envs(a, self._ONE)
+        obs = self.batch.observe(self._ONE)[0]
         if self.render_mode == "human":
             self.render()
-        return obs, float(reward), bool(terminated), bool(truncated), info
+        return obs, float(reward[0]), bool(term[0]), bool(trunc[0]), self._info(cols)
+
+    @staticmethod
+    def _info(cols: dict) -> dict[str, Any]:
+        out = {}
+        for k, (v, m) in cols.items():
+            if m is None or m[0]:
+                out[k] = _one_row(v[0])
+        return out
 
     def render(self):
         if self.render_mode is None:
             gym.logger.warn("render() called without a render_mode; pass render_mode= to make()")
             return None
-        frame = self._renderer.render(self.world, self._render_state())
+        frame = self._renderer.render(self.world, self.batch.render_state(0))
         if self.render_mode == "rgb_array":
             return frame
         self._viewer.show(frame, self.metadata["render_fps"])
@@ -229,163 +483,10 @@ class SensorPlanEnv(gym.Env):
         if self._renderer is not None:
             self._renderer.close()
 
-    # ---- helpers --------------------------------------------------------------------------
-    def _check_action(self, action) -> list[float]:
-        """Validate and clip: wrong shape or non-finite values raise ``ValueError``; values
-        outside [-1, 1] are clipped to it.  Returns the components as Python floats."""
-        shape = self.action_space.shape
-        try:
-            a = np.asarray(action, dtype=np.float64)
-        except (TypeError, ValueError) as e:
-            raise ValueError(
-                f"action must be a numeric array of shape {shape}, got {action!r}"
-            ) from e
-        if a.shape != shape:
-            raise ValueError(f"action must have shape {shape}, got shape {a.shape}")
-        vals = a.tolist()
-        out = []
-        for v in vals:
-            if not math.isfinite(v):
-                raise ValueError(f"action contains NaN or infinite values: {vals}")
-            out.append(-1.0 if v < -1.0 else (1.0 if v > 1.0 else v))
-        return out
 
-    def _execute_sensor_pose(self, pose) -> tuple[float, float, float]:
-        """The commanded sensor pose perturbed within eps_pos / eps_aim (section 4)."""
-        w = self.world
-        x, y, psi = pose
-        if w.eps_pos > 0:
-            r = w.eps_pos * math.sqrt(self.np_random.random())
-            phi = self.np_random.uniform(-math.pi, math.pi)
-            d = (r * math.cos(phi), r * math.sin(phi))
-            t = sweep((x, y), d, self._segs, 0.0, w.skin)
-            x, y = x + t * d[0], y + t * d[1]
-        if w.eps_aim > 0:
-            psi = psi + self.np_random.uniform(-w.eps_aim, w.eps_aim)
-        return (x, y, psi)
-
-    def _read_sensor(self, pose) -> None:
-        sp = self._execute_sensor_pose(pose)
-        self.sensor_pose = sp
-        self.scan = self.sensor.read(sp, self._segs, self.np_random)
-
-    def _observe(self):
-        return self._obs(self.world, self.pose, self.scan)
-
-    def _base_info(self) -> dict[str, Any]:
-        w = self.world
-        if self.pose is None:
-            return {"is_success": False, "recognizing": False, "distance_to_region": math.inf}
-        x, y, psi = self.pose
-        return {
-            "recognizing": w.recognizing(x, y, psi),
-            "distance_to_region": w.distance_to_region(x, y),
-        }
-
-    def _render_state(self) -> dict[str, Any]:
-        return {
-            "pose": self.pose,
-            "sensor_pose": self.sensor_pose,
-            "scan": self.scan,
-            "recognizing": bool(self.pose is not None and self.world.recognizing(*self.pose)),
-            "title": f"{type(self).__name__}: {self.world.scene.name}",
-        }
-
-    # ---- hooks ----------------------------------------------------------------------------
-    def _reset_episode(self, options: dict) -> None:  # pragma: no cover - abstract
-        raise NotImplementedError
-
-    def _step(self, a: np.ndarray):  # pragma: no cover - abstract
-        raise NotImplementedError
-
-    def _info(self) -> dict[str, Any]:  # pragma: no cover - abstract
-        raise NotImplementedError
-
-
-class RobotEnv(SensorPlanEnv):
-    """A mobile sensor: a disc (or point) robot that drives and turns, with collisions.
-
-    Action ``Box(-1, 1, (k,), float32)`` whose first three components are ``forward``,
-    ``lateral`` (to the left) and ``turn`` (counter-clockwise).  The robot first translates by
-    ``max_speed * (forward, lateral)`` in its current heading's frame, then turns by
-    ``max_turn * turn``.  The translation is swept against walls, obstacles (and the hidden
-    target in Recognize): on contact the robot stops there (it never passes through), and
-    ``info["collided"]`` is True.  Out-of-range components are clipped to [-1, 1].
-
-    ``random_start=True`` draws every episode's start pose from ``self.np_random``: a
-    uniform free position that does not recognize yet, in a part of the free space from
-    which the recognizable region is reachable, with a uniform heading (default: the
-    scene's ``start``, like TOMMY's fixed start in the paper).
-    """
-
-    def __init__(
-        self,
-        scene="lab",
-        *,
-        max_speed: float | None = None,
-        max_turn: float = math.pi / 8,
-        random_start: bool = False,
-        **kwargs,
-    ) -> None:
-        if not isinstance(random_start, bool):
-            raise ValueError(f"random_start must be True or False, got {random_start!r}")
-        self.random_start = random_start
-        for name, v in (("max_speed", max_speed), ("max_turn", max_turn)):
-            if v is not None and (
-                not isinstance(v, (int, float)) or not math.isfinite(v) or v <= 0
-            ):
-                raise ValueError(f"{name} must be a positive number, got {v!r}")
-        self._max_speed_cfg = max_speed
-        self.max_turn = float(max_turn)
-        self._extra_clearance = None  # distance to dynamic segments (Recognize's target)
-        super().__init__(scene, **kwargs)
-
-    def _episode_start(self) -> tuple[float, float, float]:
-        """The start pose of a new episode (see ``random_start``)."""
-        if not self.random_start:
-            return self.start
-        w = self.world
-        space = w._cache.get("start_space")
-        if space is None:
-            comps = shapely.get_parts(w.robot_space)
-            space = shapely.union_all(comps[shapely.intersects(comps, w.region)])
-            shapely.prepare(space)
-            w._cache["start_space"] = space
-        rng = self.np_random
-        for _ in range(10_000):
-            x = rng.uniform(w.lo[0], w.hi[0])
-            y = rng.uniform(w.lo[1], w.hi[1])
-            if shapely.contains_xy(space, x, y) and not w.in_region(x, y):
-                return (float(x), float(y), float(rng.uniform(-math.pi, math.pi)))
-        return self.start  # a region covering nearly all of the free space
-
-    @property
-    def max_speed(self) -> float:
-        """Per-step translation at full action; default 3% of the scene diameter."""
-        if self._max_speed_cfg is not None:
-            return float(self._max_speed_cfg)
-        return 0.03 * self.world.diameter
-
-    def _move(self, a: np.ndarray) -> bool:
-        x, y, psi = self.pose
-        c, s = math.cos(psi), math.sin(psi)
-        v = self.max_speed
-        a0, a1 = float(a[0]), float(a[1])
-        d = (v * (c * a0 - s * a1), v * (s * a0 + c * a1))
-        step = math.hypot(d[0], d[1])
-        w = self.world
-        # sweep only when a wall, an obstacle or the target may be within reach
-        need = step + w.robot_radius + 2 * w.skin
-        clear = w.clearance_at(x, y)
-        if self._extra_clearance is not None and clear > need:
-            clear = min(clear, self._extra_clearance(x, y))
-        if clear <= need:
-            t = sweep((x, y), d, self._segs, w.robot_radius, w.skin)
-            collided = t < 1.0
-        else:
-            t = 1.0
-            collided = False
-        psi = psi + self.max_turn * float(a[2])
-        psi = (psi + math.pi) % (2 * math.pi) - math.pi
-        self.pose = (x + t * float(d[0]), y + t * float(d[1]), psi)
-        return collided
+def _as_batch(action: Any) -> Any:
+    """One action as a batch of one (left as is when it is not numeric: the check says so)."""
+    try:
+        return np.asarray(action, dtype=np.float64)[None]
+    except (TypeError, ValueError):
+        return action

@@ -22,32 +22,35 @@ Reward
 Termination
     ``terminated`` when the pose recognizes: placement in ``recognizable_region`` and the
     aim (with ``eps_aim``) keeping both swept hulls in the field of view and range.
-    ``truncated`` after ``max_episode_steps`` (200, set at registration).
+    ``truncated`` after ``max_steps`` steps (default 200, also the registered
+    ``max_episode_steps``).
 Info
     ``is_success``, ``recognizing``, ``distance_to_region`` (Euclidean, to the exact
     region), ``collided``, ``pose``.
 Options
     ``reset(options={"start": (x, y, psi)})`` overrides the start pose (it must be free).
+Vector env
+    ``gym.make_vec("sensorplan/Navigate-v0", num_envs=N, vectorization_mode="vector_entry_point")``
+    runs N of these in one batch (:mod:`sensorplan_gym.envs.vector`).
 """
 
 from __future__ import annotations
 
-import math
-from typing import Any
-
 import numpy as np
-from gymnasium import spaces
 
-from .base import RobotEnv
+from .base import RobotBatch, SensorPlanEnv
 
-__all__ = ["NavigateEnv"]
+__all__ = ["NavigateBatch", "NavigateEnv"]
 
 
-class NavigateEnv(RobotEnv):
+class NavigateBatch(RobotBatch):
+    """Navigate-v0 over N sub-environments (see the module docstring)."""
+
     obs_kind = "robot"
 
     def __init__(
         self,
+        n: int,
         scene="lab",
         *,
         step_cost: float = 0.01,
@@ -58,51 +61,47 @@ class NavigateEnv(RobotEnv):
         self.step_cost = float(step_cost)
         self.success_bonus = float(success_bonus)
         self.shaping = float(shaping)
-        super().__init__(scene, **kwargs)
-        self.action_space = spaces.Box(-1.0, 1.0, (3,), dtype=np.float32)
-        self._collided = False
-        self._success = False
+        self.dist = np.zeros(n)
+        self.success = np.zeros(n, dtype=bool)
+        super().__init__(n, scene, **kwargs)
 
-    def _reset_episode(self, options: dict) -> None:
-        start = options.get("start")
-        if start is not None:
-            x, y, psi = (float(v) for v in start)
-            if not self.world.in_free_space(x, y):
-                raise ValueError(f"options['start'] = {start!r} is not in the robot's free space")
-            self.pose = (x, y, psi)
-        else:
-            self.pose = self._episode_start()
-        self._collided = False
-        self._success = False
-        self._dist = self.world.distance_to_region(self.pose[0], self.pose[1])
-        self._read_sensor(self.pose)
+    def _reset_one(self, i: int, options: dict) -> None:
+        self._start_from_options(i, options)
+        self.success[i] = False
 
-    def _step(self, a: np.ndarray):
-        self._collided = self._move(a)
-        self._read_sensor(self.pose)
-        x, y, psi = self.pose
-        w = self.world
-        recognizing, dist = w.query(x, y, psi)
-        reward = -self.step_cost
-        if self.shaping and math.isfinite(dist) and math.isfinite(self._dist):
-            reward += self.shaping * (self._dist - dist) / w.diameter
-        self._dist = dist
-        if recognizing:
-            reward += self.success_bonus
-        self._success = recognizing
-        info = self._info(recognizing, dist)
-        return self._observe(), reward, recognizing, False, info
+    def _after_reset(self, idx: np.ndarray) -> None:
+        super()._after_reset(idx)
+        self.dist[idx] = self.query(idx)[3]
 
-    def _info(self, recognizing: bool | None = None, dist: float | None = None) -> dict[str, Any]:
-        x, y, psi = self.pose
-        if recognizing is None:
-            recognizing = self.world.recognizing(x, y, psi)
-        if dist is None:
-            dist = self._dist
+    def reset_info(self, idx: np.ndarray) -> dict:
+        rec, _, _, dist = self.query(idx)
+        return self._cols(idx, rec, dist)
+
+    def _cols(self, idx, rec, dist) -> dict:
+        pose = np.stack([self.x[idx], self.y[idx], self.psi[idx]], axis=1)
         return {
-            "is_success": bool(recognizing),
-            "recognizing": bool(recognizing),
-            "distance_to_region": float(dist),
-            "collided": self._collided,
-            "pose": self.pose,
+            "is_success": (rec, None),
+            "recognizing": (rec, None),
+            "distance_to_region": (dist, None),
+            "collided": (self.collided[idx].copy(), None),
+            "pose": (pose, None),
         }
+
+    def step_envs(self, act: np.ndarray, idx: np.ndarray):
+        self.elapsed[idx] += 1
+        self.move(act, idx)
+        rec, _, _, dist = self.query(idx)
+        reward = np.full(len(idx), -self.step_cost)
+        if self.shaping:
+            before = self.dist[idx]
+            ok = np.isfinite(dist) & np.isfinite(before)
+            reward += np.where(ok, self.shaping * (before - dist) / self.diameter[idx], 0.0)
+        self.dist[idx] = dist
+        reward += np.where(rec, self.success_bonus, 0.0)
+        self.success[idx] = rec
+        trunc = ~rec & (self.elapsed[idx] >= self.max_steps)
+        return reward, rec, trunc, self._cols(idx, rec, dist)
+
+
+class NavigateEnv(SensorPlanEnv):
+    batch_cls = NavigateBatch

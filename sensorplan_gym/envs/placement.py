@@ -34,28 +34,94 @@ import math
 from typing import Any
 
 import numpy as np
-from gymnasium import spaces
+import shapely
 
-from .base import SensorPlanEnv
+from .base import SensorPlanBatch, SensorPlanEnv
 
-__all__ = ["PlacementEnv"]
+__all__ = ["PlacementBatch", "PlacementEnv"]
+
+
+class PlacementBatch(SensorPlanBatch):
+    """Placement-v0 over N sub-environments (see the module docstring)."""
+
+    obs_kind = "placement"
+    needs_start = False
+    horizon = 1
+
+    def __init__(self, n: int, scene="lab", *, shaping: float = 0.0, **kwargs) -> None:
+        self.shaping = float(shaping)
+        self.placed = np.zeros(n, dtype=bool)
+        super().__init__(n, scene, **kwargs)
+
+    def _has_pose(self, i: int) -> bool:
+        return bool(self.placed[i])
+
+    def action_to_pose(self, a: np.ndarray, idx: np.ndarray) -> np.ndarray:
+        """Commanded poses ``(k, 3)`` of (clipped) actions ``(k, 3)``: x and y map linearly
+        onto the bounding box, aim ``pi * a[2]`` radians."""
+        lo, hi = self.lo[idx], self.hi[idx]
+        xy = lo + 0.5 * (a[:, :2] + 1.0) * (hi - lo)
+        return np.concatenate([xy, math.pi * a[:, 2:3]], axis=1)
+
+    def _reset_one(self, i: int, options: dict) -> None:
+        self.placed[i] = False
+        self.has_scan[i] = False
+
+    def reset_info(self, idx: np.ndarray) -> dict:
+        k = len(idx)
+        f = np.zeros(k, dtype=bool)
+        return {
+            "is_success": (f, None),
+            "recognizing": (f.copy(), None),
+            "distance_to_region": (np.full(k, math.inf), None),
+        }
+
+    def evaluate(self, pose: np.ndarray, idx: np.ndarray) -> tuple[np.ndarray, dict]:
+        """Rewards ``(k,)`` and info columns of commanded poses ``(k, 3)`` (no state change,
+        no randomness)."""
+        rec, inside, aim, dist = self.query(idx, pose[:, 0], pose[:, 1], pose[:, 2])
+        reward = rec.astype(np.float64)
+        if self.shaping:
+            reward -= np.where(np.isfinite(dist), self.shaping * dist / self.diameter[idx], 0.0)
+        cols = {
+            "is_success": (rec, None),
+            "recognizing": (rec.copy(), None),
+            "in_region": (inside, None),
+            "aim_ok": (aim, None),
+            "distance_to_region": (dist, None),
+        }
+        return reward, cols
+
+    def step_envs(self, act: np.ndarray, idx: np.ndarray):
+        pose = self.action_to_pose(act, idx)
+        reward, cols = self.evaluate(pose, idx)
+        self.x[idx], self.y[idx], self.psi[idx] = pose.T
+        self.placed[idx] = True
+        free = np.array(
+            [
+                shapely.contains_xy(self.worlds[i].robot_space, p[0], p[1])
+                for i, p in zip(idx.tolist(), pose, strict=True)
+            ],
+            dtype=bool,
+        )
+        self.has_scan[idx] = False
+        if free.any():
+            self.sense(idx[free])
+        executed = np.stack([self.sx[idx], self.sy[idx], self.spsi[idx]], axis=1)
+        executed[~free] = pose[~free]
+        cols["pose"] = (pose, None)
+        cols["executed_pose"] = (executed, None)
+        k = len(idx)
+        return reward, np.ones(k, dtype=bool), np.zeros(k, dtype=bool), cols
 
 
 class PlacementEnv(SensorPlanEnv):
-    obs_kind = "placement"
-    needs_start = False
-
-    def __init__(self, scene="lab", *, shaping: float = 0.0, **kwargs) -> None:
-        self.shaping = float(shaping)
-        super().__init__(scene, **kwargs)
-        self.action_space = spaces.Box(-1.0, 1.0, (3,), dtype=np.float32)
+    batch_cls = PlacementBatch
 
     def action_to_pose(self, a: np.ndarray) -> tuple[float, float, float]:
         """The commanded pose of an (already clipped) action."""
-        w = self.world
-        x = w.lo[0] + 0.5 * (float(a[0]) + 1.0) * (w.hi[0] - w.lo[0])
-        y = w.lo[1] + 0.5 * (float(a[1]) + 1.0) * (w.hi[1] - w.lo[1])
-        return (float(x), float(y), math.pi * float(a[2]))
+        p = self.batch.action_to_pose(np.asarray(a, dtype=np.float64)[None], self._ONE)[0]
+        return (float(p[0]), float(p[1]), float(p[2]))
 
     def pose_to_action(self, pose) -> np.ndarray:
         """Inverse of :meth:`action_to_pose` (aim wrapped to [-pi, pi])."""
@@ -68,46 +134,7 @@ class PlacementEnv(SensorPlanEnv):
 
     def evaluate(self, pose) -> dict[str, Any]:
         """Reward and diagnostics of a commanded pose (no state change, no randomness)."""
-        w = self.world
-        x, y, psi = pose
-        in_region = w.in_region(x, y)
-        aim_ok = w.aim_ok(x, y, psi)
-        dist = w.distance_to_region(x, y)
-        success = in_region and aim_ok
-        reward = float(success)
-        if self.shaping and math.isfinite(dist):
-            reward -= self.shaping * dist / w.diameter
-        return {
-            "reward": reward,
-            "is_success": success,
-            "recognizing": success,
-            "in_region": in_region,
-            "aim_ok": aim_ok,
-            "distance_to_region": dist,
-        }
-
-    def _reset_episode(self, options: dict) -> None:
-        self.pose = None
-        self.sensor_pose = None
-        self.scan = None
-        self._last: dict[str, Any] | None = None
-
-    def _step(self, a: np.ndarray):
-        pose = self.action_to_pose(a)
-        ev = self.evaluate(pose)
-        self.pose = pose
-        if self.world.in_free_space(pose[0], pose[1]):
-            self._read_sensor(pose)
-        else:
-            self.sensor_pose, self.scan = pose, None
-        info = {k: v for k, v in ev.items() if k != "reward"}
-        info["pose"] = pose
-        info["executed_pose"] = self.sensor_pose
-        self._last = info
-        return self._observe(), ev["reward"], True, False, info
-
-    def _observe(self):
-        return self._obs(self.world)
-
-    def _info(self) -> dict[str, Any]:
-        return {"is_success": False, "recognizing": False, "distance_to_region": math.inf}
+        r, cols = self.batch.evaluate(np.asarray(pose, dtype=np.float64)[None], self._ONE)
+        out = {"reward": float(r[0])}
+        out.update(self._info(cols))
+        return out

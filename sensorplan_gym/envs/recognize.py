@@ -21,7 +21,9 @@ Reward
     timeout counts as wrong).
 Termination
     ``terminated`` on a declaration; ``truncated`` when ``max_steps`` steps have passed
-    (``max_steps=None`` takes ``max_episode_steps`` from the registration, 200).
+    (default 200, also the registered ``max_episode_steps``); the timeout penalty is
+    applied by the env itself, so it holds under ``gym.make``, ``make_vec`` and direct
+    construction alike.
 Info
     ``is_success`` (declared and right), ``declared`` (None, "G" or "H"),
     ``recognizing`` (the pose is in the exact recognizable region with a valid aim),
@@ -36,108 +38,114 @@ from typing import Any
 
 import numpy as np
 import shapely
-from gymnasium import spaces
 
-from ..core.sensor import Segments
-from ..core.world import _FastDistance
-from .base import RobotEnv
+from ..core.segments import SegmentRows, pad_segments, point_segment_distance, segment_normals
+from .base import RobotBatch, SensorPlanEnv
 
-__all__ = ["RecognizeEnv"]
+__all__ = ["RecognizeBatch", "RecognizeEnv"]
+
+_NONE, _G, _H = 0, 1, 2
+_LABEL = np.array([None, "G", "H"], dtype=object)
 
 
-class RecognizeEnv(RobotEnv):
+class RecognizeBatch(RobotBatch):
+    """Recognize-v0 over N sub-environments (see the module docstring)."""
+
     obs_kind = "robot"
+    action_dim = 4
 
-    def __init__(
-        self, scene="lab", *, step_cost: float = 0.01, max_steps: int | None = None, **kwargs
-    ) -> None:
+    def __init__(self, n: int, scene="lab", *, step_cost: float = 0.01, **kwargs) -> None:
         self.step_cost = float(step_cost)
-        if max_steps is not None and (not isinstance(max_steps, int) or max_steps < 1):
-            raise ValueError(f"max_steps must be a positive integer or None, got {max_steps!r}")
-        self.max_steps = max_steps
-        super().__init__(scene, **kwargs)
-        self.action_space = spaces.Box(-1.0, 1.0, (4,), dtype=np.float32)
-        self._side = "G"
-        self._elapsed = 0
-        self._declared = None
-        self._collided = False
+        self.side = np.zeros(n, dtype=np.int8)  # _G or _H: where the hidden target is
+        self.declared = np.zeros(n, dtype=np.int8)
+        self.target_polys: list[np.ndarray | None] = [None] * n
+        self.tsegs = SegmentRows(n)
+        super().__init__(n, scene, **kwargs)
 
-    def _limit(self) -> int | None:
-        if self.max_steps is not None:
-            return self.max_steps
-        spec = self.spec
-        return spec.max_episode_steps if spec is not None else None
-
-    def _place_target(self) -> None:
-        w = self.world
-        rng = self.np_random
-        self._side = "G" if rng.random() < 0.5 else "H"
-        which = "goal" if self._side == "G" else "failure"
+    def _place_target(self, i: int) -> None:
+        w = self.worlds[i]
+        rng = self.rngs[i]
+        side = _G if rng.random() < 0.5 else _H
+        which = "goal" if side == _G else "failure"
         r = w.robot_radius
+        p = shapely.Point(self.x[i], self.y[i])
         for _ in range(20):
             q = w.sample_in(which, rng)
             th = rng.uniform(0.0, 2 * math.pi) if w.theta is None else 0.0
             c, s = math.cos(th), math.sin(th)
             poly = w.target @ np.array([[c, s], [-s, c]]) + q
-            segs = np.concatenate([poly, np.roll(poly, -1, axis=0)], axis=1)
             # keep the robot clear of the target at the start
-            if self.pose is None or _clear(self.pose[:2], poly, segs, r):
+            if shapely.Polygon(poly).distance(p) > r + 1e-9:
                 break
-        self._target_poly = poly
-        self._tsegs = segs
-        self._segs = w.seg_set + Segments(segs)
-        self._extra_clearance = _FastDistance(segs)
+        segs = np.concatenate([poly, np.roll(poly, -1, axis=0)], axis=1)
+        nrm = segment_normals(segs)
+        self.side[i] = side
+        self.target_polys[i] = poly
+        self.tsegs.set_row(i, pad_segments(segs, nrm, len(segs)))
+        allsegs = np.concatenate([w.segs, segs])
+        self.set_segments(
+            i, pad_segments(allsegs, np.concatenate([w.seg_normals, nrm]), len(allsegs))
+        )
 
-    def _reset_episode(self, options: dict) -> None:
-        self.pose = self._episode_start()
-        self._elapsed = 0
-        self._declared = None
-        self._collided = False
-        self._place_target()
-        self._read_sensor(self.pose)
+    def _reset_one(self, i: int, options: dict) -> None:
+        self._start_from_options(i, {})
+        self.declared[i] = _NONE
+        self._place_target(i)
 
-    def _step(self, a: np.ndarray):
-        self._elapsed += 1
-        self._collided = self._move(a)
-        self._read_sensor(self.pose)
-        reward = -self.step_cost
-        terminated = truncated = False
-        d = float(a[3])
-        if d < -1 / 3 or d > 1 / 3:
-            self._declared = "G" if d < -1 / 3 else "H"
-            reward += 1.0 if self._declared == self._side else -1.0
-            terminated = True
-        else:
-            limit = self._limit()
-            if limit is not None and self._elapsed >= limit:
-                reward -= 1.0
-                truncated = True
-        info = self._info()
-        if terminated or truncated:
-            info["target_in"] = self._side
-        return self._observe(), reward, terminated, truncated, info
+    def _extra_clearance(self, idx, x, y, mask) -> np.ndarray:
+        out = np.full(len(idx), np.inf)
+        if mask.any():
+            j = idx[mask]
+            out[mask] = point_segment_distance(x[mask], y[mask], self._rows(self.tsegs, j))
+        return out
 
-    def _info(self) -> dict[str, Any]:
-        x, y, psi = self.pose
-        recognizing, dist = self.world.query(x, y, psi)
+    def reset_info(self, idx: np.ndarray) -> dict:
+        return self._cols(idx, np.zeros(len(idx), dtype=bool))
+
+    def _cols(self, idx: np.ndarray, ended: np.ndarray) -> dict:
+        rec, _, _, dist = self.query(idx)
+        dec = self.declared[idx]
         return {
-            "is_success": self._declared is not None and self._declared == self._side,
-            "declared": self._declared,
-            "recognizing": recognizing,
-            "distance_to_region": dist,
-            "collided": self._collided,
-            "pose": self.pose,
+            "is_success": ((dec != _NONE) & (dec == self.side[idx]), None),
+            "declared": (_LABEL[dec], None),
+            "recognizing": (rec, None),
+            "distance_to_region": (dist, None),
+            "collided": (self.collided[idx].copy(), None),
+            "pose": (np.stack([self.x[idx], self.y[idx], self.psi[idx]], axis=1), None),
+            "target_in": (_LABEL[self.side[idx]], ended),
         }
 
-    def _render_state(self) -> dict[str, Any]:
-        st = super()._render_state()
-        st["target"] = self._target_poly
-        if self._declared:
-            st["title"] += f"  declared {self._declared} (target in {self._side})"
+    def step_envs(self, act: np.ndarray, idx: np.ndarray):
+        self.elapsed[idx] += 1
+        self.move(act, idx)
+        d = act[:, 3]
+        dec = np.where(d < -1 / 3, _G, np.where(d > 1 / 3, _H, _NONE)).astype(np.int8)
+        self.declared[idx] = dec
+        term = dec != _NONE
+        reward = np.full(len(idx), -self.step_cost)
+        reward += np.where(term, np.where(dec == self.side[idx], 1.0, -1.0), 0.0)
+        trunc = ~term & (self.elapsed[idx] >= self.max_steps)
+        reward -= trunc  # a timeout counts as wrong
+        return reward, term, trunc, self._cols(idx, term | trunc)
+
+    def render_state(self, i: int) -> dict[str, Any]:
+        st = super().render_state(i)
+        st["target"] = self.target_polys[i]
+        if self.declared[i] != _NONE:
+            st["title"] += (
+                f"  declared {_LABEL[self.declared[i]]} (target in {_LABEL[self.side[i]]})"
+            )
         return st
 
 
-def _clear(p, poly: np.ndarray, segs: np.ndarray, r: float) -> bool:
-    """The robot disc at ``p`` does not meet the target polygon."""
-    P = shapely.Polygon(poly)
-    return P.distance(shapely.Point(p)) > r + 1e-9
+class RecognizeEnv(SensorPlanEnv):
+    batch_cls = RecognizeBatch
+
+    @property
+    def _side(self) -> str:
+        """Where the hidden target is ("G" or "H"): for tests and evaluation only."""
+        return _LABEL[self.batch.side[0]]
+
+    @property
+    def _target_poly(self) -> np.ndarray | None:
+        return self.batch.target_polys[0]

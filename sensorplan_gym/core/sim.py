@@ -1,0 +1,343 @@
+"""The batched simulation core: N sensor robots (each in its own world, with its own random
+stream) held in arrays and advanced by one vectorised call.
+
+:class:`BatchSim` owns the state every task shares -- the world of each sub-environment
+(copied into padded rows at its reset), the robot poses, the executed sensor poses and the
+latest scans -- and the mechanics:
+
+* :meth:`BatchSim.drive` -- translate in the robot frame, swept against walls, obstacles and
+  (Recognize) the target, then turn; the sweep runs only for robots whose conservative
+  clearance is below the step;
+* :meth:`BatchSim.sense` -- perturb the commanded sensor poses within ``eps_pos``/``eps_aim``
+  and cast every beam of every robot in one pass (:func:`.sensor.cast_batch`);
+* :meth:`BatchSim.query` -- exact recognizability (shapely ``contains_xy`` on the exact
+  region, the aim check) and the distance to the region.
+
+The tasks (``sensorplan_gym.envs``) subclass it with their reset and reward rules; the
+single env is the batch of one and the vector env the batch of N, so both run this code.
+
+Randomness
+----------
+Sub-environment ``i`` draws only from its own ``numpy`` generator ``rngs[i]``: directly at its
+resets (scene, start, target) and, for the per-step sensor uncertainty and noise, through a
+block of pre-drawn uniforms and normals refilled from that generator every
+:data:`BLOCK` steps.  A sub-environment of a batch therefore produces exactly the numbers a
+single environment seeded the same way produces.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from gymnasium.utils import seeding
+
+from .collision import sweep_batch
+from .queries import aim_ok_batch, in_region_batch, region_distance_batch
+from .segments import SegmentRows
+from .sensor import add_noise, beam_offsets, cast_batch
+from .world import World, field_lookup
+
+__all__ = ["BLOCK", "BatchSim"]
+
+#: steps of pre-drawn per-step random numbers per refill
+BLOCK = 64
+TWO_PI = 2 * math.pi
+
+
+class BatchSim:
+    """State and mechanics of ``n`` sub-environments (see the module docstring).
+
+    Arrays (``N`` = ``n``): ``x, y, psi`` commanded poses (world frame, radians);
+    ``sx, sy, spsi`` executed sensor poses; ``scan_dist (N, B)``, ``scan_normal (N, B, 2)``,
+    ``scan_hit (N, B)``, ``scan_ang (N, B)`` the latest readings; ``worlds[i]`` the
+    :class:`World` of sub-environment ``i``.
+    """
+
+    def __init__(self, n: int, n_beams: int, noise: float, robot_radius: float) -> None:
+        self.n = int(n)
+        self.n_beams = int(n_beams)
+        self.noise = float(noise)
+        self.robot_radius = float(robot_radius)
+        N, B = self.n, self.n_beams
+        self.worlds: list[World | None] = [None] * N
+        self.rngs: list[np.random.Generator] = [seeding.np_random(None)[0] for _ in range(N)]
+        self._U = np.zeros((N, BLOCK, 3))
+        self._Z = np.zeros((N, BLOCK, B))
+        self._ptr = np.full(N, BLOCK)
+        self.x, self.y, self.psi = np.zeros(N), np.zeros(N), np.zeros(N)
+        self.sx, self.sy, self.spsi = np.zeros(N), np.zeros(N), np.zeros(N)
+        self.scan_dist = np.zeros((N, B))
+        self.scan_normal = np.zeros((N, B, 2))
+        self.scan_hit = np.zeros((N, B), dtype=bool)
+        self.scan_ang = np.zeros((N, B))
+        self.has_scan = np.zeros(N, dtype=bool)
+        self.segs = SegmentRows(N)  # walls, obstacles (and the target in Recognize)
+        self.region_segs = SegmentRows(N)
+        self.regions = np.empty(N, dtype=object)
+        self.hulls = np.zeros((N, 2, 1, 2))
+        self.centers = np.zeros((N, 2, 2))
+        self.fields = np.zeros((N, 1, 1))
+        self.field_o = np.zeros((N, 2))
+        self.field_inv_h = np.ones(N)
+        for name in (
+            "diameter",
+            "reach",
+            "skin",
+            "eps_pos",
+            "eps_aim",
+            "fov",
+            "max_range",
+            "max_speed",
+        ):
+            setattr(self, name, np.ones(N))
+        self.lo, self.hi = np.zeros((N, 2)), np.ones((N, 2))
+        self.goal_c, self.fail_c = np.zeros((N, 2)), np.zeros((N, 2))
+        self.offsets = np.zeros((N, B))
+        self.stochastic = np.zeros(N, dtype=bool)
+        self.aim_trivial = np.zeros(N, dtype=bool)
+        self._one_world = False
+
+    # ---- randomness -------------------------------------------------------------------
+    def seed_env(self, i: int, seed: int | None) -> None:
+        """Re-seed sub-environment ``i`` (``seed=None``: fresh OS entropy) and drop its
+        pre-drawn block."""
+        self.rngs[i] = seeding.np_random(seed)[0]
+        self._ptr[i] = BLOCK
+
+    def _draws(self, idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The next per-step draws of sub-environments ``idx``: uniforms ``(k, 3)`` and
+        standard normals ``(k, B)``."""
+        empty = idx[self._ptr[idx] >= BLOCK]
+        for i in empty.tolist():
+            rng = self.rngs[i]
+            self._U[i] = rng.random((BLOCK, 3))
+            self._Z[i] = rng.standard_normal((BLOCK, self.n_beams))
+            self._ptr[i] = 0
+        p = self._ptr[idx]
+        self._ptr[idx] += 1
+        return self._U[idx, p], self._Z[idx, p]
+
+    # ---- worlds -----------------------------------------------------------------------
+    def _grow(self, name: str, shape: tuple[int, ...]) -> np.ndarray:
+        a = getattr(self, name)
+        if any(s > t for s, t in zip(shape, a.shape[1:], strict=True)):
+            new = np.zeros((self.n, *np.maximum(shape, a.shape[1:])))
+            setattr(self, name, new)
+            a = new
+        return a
+
+    def load_world(self, i: int, world: World, max_speed: float | None = None) -> None:
+        """Copy ``world`` into row ``i`` (a no-op when it is already there)."""
+        if self.worlds[i] is world:
+            return
+        self.worlds[i] = world
+        r = world.batch_rows()
+        self.segs.set_row(i, r["segs"])
+        self.region_segs.set_row(i, r["region_segs"])
+        self.regions[i] = world.region
+        k = r["hulls"].shape[1]
+        hulls = self._grow("hulls", (2, k, 2))
+        hulls[i, :, :k] = r["hulls"]
+        hulls[i, :, k:] = r["hulls"][:, -1:]
+        self.centers[i] = r["centers"]
+        F, ox, oy, inv_h = r["field"]
+        fields = self._grow("fields", F.shape)
+        fields[i] = 0.0
+        fields[i, : F.shape[0], : F.shape[1]] = F
+        self.field_o[i] = (ox, oy)
+        self.field_inv_h[i] = inv_h
+        self.diameter[i] = world.diameter
+        self.reach[i] = world.reach
+        self.skin[i] = world.skin
+        self.eps_pos[i] = world.eps_pos
+        self.eps_aim[i] = world.eps_aim
+        self.fov[i] = world.fov
+        self.max_range[i] = world.max_range
+        self.max_speed[i] = 0.03 * world.diameter if max_speed is None else max_speed
+        self.lo[i], self.hi[i] = world.lo, world.hi
+        self.goal_c[i], self.fail_c[i] = world.goal_center, world.failure_center
+        self.offsets[i] = beam_offsets(self.n_beams, world.fov)
+        self.stochastic[i] = world.eps_pos > 0 or world.eps_aim > 0 or self.noise > 0
+        self.aim_trivial[i] = world.fov >= TWO_PI - 1e-12 and math.isinf(world.max_range)
+        self._one_world = all(w is world for w in self.worlds)
+
+    def set_segments(self, i: int, rows: np.ndarray) -> None:
+        """Row ``i`` of the sensed/collided segments := ``rows`` ``(6, k)``."""
+        self.segs.set_row(i, rows)
+
+    # ---- mechanics --------------------------------------------------------------------
+    def drive(self, act: np.ndarray, idx: np.ndarray, max_turn: float) -> np.ndarray:
+        """Move sub-environments ``idx`` by actions ``act`` ``(k, >=3)`` in [-1, 1]
+        (forward, lateral, turn; see ``RobotEnv``).  Returns ``collided (k,)``."""
+        sel = self.sel(idx)
+        x, y, psi = self.x[sel], self.y[sel], self.psi[sel]
+        c, s = np.cos(psi), np.sin(psi)
+        v = self.max_speed[sel]
+        a0, a1 = act[:, 0], act[:, 1]
+        dx = v * (c * a0 - s * a1)
+        dy = v * (s * a0 + c * a1)
+        # sweep only where a wall, an obstacle or the target may be within reach
+        need = np.hypot(dx, dy) + self.robot_radius + 2 * self.skin[sel]
+        clear = field_lookup(
+            self.fields[sel],
+            self.field_o[sel, 0],
+            self.field_o[sel, 1],
+            self.field_inv_h[sel],
+            x,
+            y,
+        )
+        clear = np.minimum(clear, self._extra_clearance(idx, x, y, clear > need))
+        t = np.ones(len(idx))
+        close = clear <= need
+        if close.any():
+            j = idx[close]
+            t[close] = sweep_batch(
+                x[close],
+                y[close],
+                dx[close],
+                dy[close],
+                self._rows(self.segs, j),
+                self.robot_radius,
+                self.skin[j],
+            )
+        self.x[sel] = x + t * dx
+        self.y[sel] = y + t * dy
+        self.psi[sel] = (psi + max_turn * act[:, 2] + math.pi) % TWO_PI - math.pi
+        return t < 1.0
+
+    def _extra_clearance(self, idx, x, y, mask) -> np.ndarray:
+        """Distance to segments that the clearance field does not know (the target in
+        Recognize), where ``mask``; ``inf`` elsewhere.  Overridden by tasks."""
+        return np.full(len(idx), np.inf)
+
+    @staticmethod
+    def _rows(rows: SegmentRows, j: np.ndarray):
+        return _Rows(rows, j)
+
+    def sense(self, idx: np.ndarray) -> None:
+        """Read the sensors of sub-environments ``idx`` from their executed poses (the
+        commanded pose displaced uniformly within ``eps_pos`` -- cut short at walls -- and
+        turned uniformly within ``eps_aim``), with range noise."""
+        sel = self.sel(idx)
+        x, y, psi = self.x[sel], self.y[sel], self.psi[sel]
+        st = self.stochastic[sel]
+        z = None
+        if st.any():
+            j = idx[st]
+            U, Z = self._draws(j)
+            z = np.zeros((len(idx), self.n_beams))
+            z[st] = Z
+            ep, ea = self.eps_pos[j], self.eps_aim[j]
+            r = ep * np.sqrt(U[:, 0])
+            phi = -math.pi + TWO_PI * U[:, 1]
+            ddx, ddy = r * np.cos(phi), r * np.sin(phi)
+            pos = ep > 0
+            sx, sy, sp = x[st], y[st], psi[st]
+            if pos.any():
+                k = j[pos]
+                t = sweep_batch(
+                    sx[pos],
+                    sy[pos],
+                    ddx[pos],
+                    ddy[pos],
+                    self._rows(self.segs, k),
+                    0.0,
+                    self.skin[k],
+                )
+                sx[pos] = sx[pos] + t * ddx[pos]
+                sy[pos] = sy[pos] + t * ddy[pos]
+            sp = np.where(ea > 0, sp + (-ea + 2 * ea * U[:, 2]), sp)
+            x, y, psi = x.copy(), y.copy(), psi.copy()
+            x[st], y[st], psi[st] = sx, sy, sp
+        ang = self.offsets[sel] + psi[:, None]
+        dist, nrm, hit = cast_batch(x, y, ang, self._rows(self.segs, idx), self.reach[sel])
+        if z is not None and self.noise > 0:
+            dist = add_noise(dist, hit, z, self.noise, self.reach[sel])
+        self.sx[sel], self.sy[sel], self.spsi[sel] = x, y, psi
+        self.scan_dist[sel] = dist
+        self.scan_normal[sel] = nrm
+        self.scan_hit[sel] = hit
+        self.scan_ang[sel] = ang
+        self.has_scan[sel] = True
+
+    def query(
+        self, idx: np.ndarray, x: np.ndarray | None = None, y=None, psi=None
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """``(recognizing, in_region, aim_ok, distance_to_region)`` ``(k,)`` for the poses
+        of sub-environments ``idx`` (or the given poses): placement in the exact
+        recognizable region and aim OK; Euclidean distance (0 inside, ``inf`` if the region
+        is empty)."""
+        sel = self.sel(idx)
+        if x is None:
+            x, y, psi = self.x[sel], self.y[sel], self.psi[sel]
+        regions = self.regions[sel]
+        first = regions[0]
+        if self._one_world and len(regions) > 1:
+            inside = in_region_batch(first, x, y)  # one prepared geometry: a faster path
+        else:
+            inside = in_region_batch(regions, x, y)
+        if self.aim_trivial[sel].all():
+            aim = np.ones(len(x), dtype=bool)
+        else:
+            aim = aim_ok_batch(
+                x,
+                y,
+                psi,
+                self.hulls[sel],
+                self.centers[sel],
+                fov=self.fov[sel],
+                eps_aim=self.eps_aim[sel],
+                eps_pos=self.eps_pos[sel],
+                max_range=self.max_range[sel],
+            )
+        dist = region_distance_batch(self._rows(self.region_segs, idx), x, y, inside)
+        return inside & aim, inside, aim, dist
+
+    def sel(self, idx: np.ndarray) -> slice | np.ndarray:
+        """An index for sub-environments ``idx`` (sorted, distinct): a slice (views, no
+        copies) when they are all of them."""
+        return _ALL if len(idx) == self.n else idx
+
+    # ---- one sub-environment, for single envs, oracles and rendering -------------------
+    def pose(self, i: int) -> tuple[float, float, float]:
+        return (float(self.x[i]), float(self.y[i]), float(self.psi[i]))
+
+    def sensor_pose(self, i: int) -> tuple[float, float, float]:
+        return (float(self.sx[i]), float(self.sy[i]), float(self.spsi[i]))
+
+    def scan(self, i: int) -> tuple[np.ndarray, ...] | None:
+        """``(dist, normal, hit, angles)`` of sub-environment ``i`` (copies) or ``None``."""
+        if not self.has_scan[i]:
+            return None
+        return (
+            self.scan_dist[i].copy(),
+            self.scan_normal[i].copy(),
+            self.scan_hit[i].copy(),
+            self.scan_ang[i].copy(),
+        )
+
+    def __getstate__(self) -> dict[str, Any]:
+        return self.__dict__.copy()
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        import shapely
+
+        self.__dict__.update(state)
+        for g in self.regions:
+            if g is not None:
+                shapely.prepare(g)
+
+
+_ALL = slice(None)
+
+
+class _Rows:
+    """Rows ``j`` of a :class:`SegmentRows` (gathered once; all when ``j`` covers them)."""
+
+    __slots__ = ("x0", "y0", "ex", "ey", "nx", "ny")
+
+    def __init__(self, rows: SegmentRows, j: np.ndarray) -> None:
+        d = rows.data if len(j) == rows.data.shape[1] else rows.data[:, j]
+        self.x0, self.y0, self.ex, self.ey, self.nx, self.ny = d
