@@ -162,10 +162,9 @@ class SensorPlanVectorEnv(VectorEnv):
         return None
 
     def close_extras(self, **kwargs: Any) -> None:
-        if self._viewer is not None:
-            self._viewer.close()
-        if self._renderer is not None:
-            self._renderer.close()
+        for part in (getattr(self, "_viewer", None), getattr(self, "_renderer", None)):
+            if part is not None:
+                part.close()
 
     # ---- info dicts -------------------------------------------------------------------
     def _merge(self, infos: dict, cols: dict, idx: np.ndarray) -> dict:
