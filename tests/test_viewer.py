@@ -215,3 +215,63 @@ def test_cli_export(tmp_path, capsys):
     assert "layer:recognizable" in text and "motion=stationary" in text
     assert main(["view", "nosuch", "--export", str(out)]) == 2
     assert "unknown scene" in capsys.readouterr().err
+
+
+# ---- rollouts and their replay -----------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def rollout():
+    from sensorplan_gym.viewer.replay import record_rollout
+
+    return record_rollout("sensorplan/Recognize-v0", policy="oracle", seed=0, scene="lab")
+
+
+def test_record_rollout(rollout, tmp_path):
+    from sensorplan_gym.viewer.replay import FORMAT, load_rollout, save_rollout
+
+    assert rollout["format"] == FORMAT
+    steps = rollout["steps"]
+    assert len(steps) >= 3 and steps[0]["reward"] is None
+    assert all(s["pose"] is not None and len(s["pose"]) == 3 for s in steps)
+    assert steps[-1]["recognizing"]  # the oracle ends at a recognizing pose
+    assert any(s["target"] for s in steps)  # Recognize reveals the target to its renderer
+    bx, by = steps[1]["beams"]
+    assert len(bx) == len(by) == len(steps[1]["hits"]) > 0
+    assert rollout["return"] == pytest.approx(sum(s["reward"] for s in steps[1:]))
+    p = save_rollout(rollout, tmp_path / "ep.json")
+    assert load_rollout(p) == json.loads(json.dumps(rollout))
+
+
+def test_load_rollout_errors(tmp_path):
+    from sensorplan_gym.viewer.replay import load_rollout
+
+    with pytest.raises(FileNotFoundError):
+        load_rollout(tmp_path / "none.json")
+    bad = tmp_path / "bad.json"
+    bad.write_text("{}")
+    with pytest.raises(ValueError, match="not a rollout file"):
+        load_rollout(bad)
+    bad.write_text('{"format": "sensorplan-rollout/1", "scene": {}, "region": {}}')
+    with pytest.raises(ValueError, match="missing key 'steps'"):
+        load_rollout(bad)
+
+
+def test_replay_layout_first_frame(rollout):
+    pytest.importorskip("bokeh")
+    from sensorplan_gym.viewer.replay import replay_layout
+
+    lay = replay_layout(rollout)
+    robot = lay.select_one({"name": "src:replay_robot"})
+    assert robot.data["x"] == [rollout["steps"][0]["pose"][0]]
+    slider = lay.select_one({"name": "replay_step"})
+    assert slider.end == len(rollout["steps"]) - 1
+    assert slider.js_property_callbacks["change:value"]  # the browser redraws each step
+
+
+def test_app_has_a_replay_tab(lab, rollout):
+    pytest.importorskip("bokeh")
+    from sensorplan_gym.viewer.app import ViewerApp
+
+    app = ViewerApp(lab, rollout=rollout)
+    assert [t.title for t in app.root.tabs] == ["Scene and regions", "Replay"]

@@ -189,24 +189,16 @@ def _wait_port(port: int, proc: subprocess.Popen, timeout: float = 60) -> None:
 
 
 @pytest.fixture
-def served(tmp_path):
-    """(app url, devtools client) with the app and chromium running; both stopped after."""
-    app_port, dbg_port = _free_port(), _free_port()
-    env = dict(os.environ, PYTHONPATH=str(REPO), MPLBACKEND="Agg")
-    app = subprocess.Popen(
-        [sys.executable, "-m", "sensorplan_gym.viewer.cli", "lab", "--port", str(app_port),
-         "--no-browser"],
-        cwd=tmp_path, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+def browser(tmp_path):
+    """A headless chromium with its DevTools client; stopped after the test."""
+    dbg_port = _free_port()
+    proc = subprocess.Popen(
+        [CHROMIUM, *FLAGS, f"--user-data-dir={tmp_path / 'profile'}",
+         f"--remote-debugging-port={dbg_port}", "--window-size=1300,900", "about:blank"],
+        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
     )  # fmt: skip
-    browser = None
     try:
-        _wait_port(app_port, app)
-        browser = subprocess.Popen(
-            [CHROMIUM, *FLAGS, f"--user-data-dir={tmp_path / 'profile'}",
-             f"--remote-debugging-port={dbg_port}", "--window-size=1300,900", "about:blank"],
-            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-        )  # fmt: skip
-        _wait_port(dbg_port, browser)
+        _wait_port(dbg_port, proc)
         from urllib.request import urlopen
 
         end = time.monotonic() + 20
@@ -218,17 +210,36 @@ def served(tmp_path):
         assert page is not None, "no page target in chromium"
         cdp = _CDP(page["webSocketDebuggerUrl"])
         try:
-            yield f"http://127.0.0.1:{app_port}/", cdp
+            yield cdp
         finally:
             cdp.close()
     finally:
-        for p in (browser, app):
-            if p is not None:
-                p.terminate()
-                try:
-                    p.wait(timeout=10)
-                except subprocess.TimeoutExpired:
-                    p.kill()
+        _stop(proc)
+
+
+def _stop(proc: subprocess.Popen) -> None:
+    proc.terminate()
+    try:
+        proc.wait(timeout=10)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+
+
+@pytest.fixture
+def served(tmp_path, browser):
+    """(app url, devtools client) with ``sensorplan view lab`` served on a free port."""
+    app_port = _free_port()
+    env = dict(os.environ, PYTHONPATH=str(REPO), MPLBACKEND="Agg")
+    app = subprocess.Popen(
+        [sys.executable, "-m", "sensorplan_gym.viewer.cli", "lab", "--port", str(app_port),
+         "--no-browser"],
+        cwd=tmp_path, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+    )  # fmt: skip
+    try:
+        _wait_port(app_port, app)
+        yield f"http://127.0.0.1:{app_port}/", browser
+    finally:
+        _stop(app)
 
 
 DOC = "Bokeh.documents[0]"
@@ -321,3 +332,27 @@ def test_served_app_edit_in_chromium(served, tmp_path):
         timeout=60,
     )
     assert a2 == pytest.approx(recognizable_region(moved, model="partial").area, rel=1e-9)
+
+
+def test_replay_tab_in_exported_file(browser, tmp_path):
+    from sensorplan_gym.core.world import load_scene
+    from sensorplan_gym.viewer.export import export_html
+    from sensorplan_gym.viewer.replay import record_rollout
+
+    ro = record_rollout("sensorplan/Recognize-v0", policy="oracle", seed=1, scene="lab")
+    path = export_html(load_scene("lab"), tmp_path / "view.html", rollout=ro)
+    cdp = browser
+    cdp.call("Page.navigate", url=path.as_uri())
+    cdp.wait_js(f"window.Bokeh !== undefined && Bokeh.documents.length > 0 && !!{_model('tabs')}")
+    cdp.js(f"{_model('tabs')}.active = 1; true")
+    k = len(ro["steps"]) // 2
+    cdp.js(f"{_model('replay_step')}.value = {k}; true")
+    caption = cdp.wait_js(
+        f"(() => {{ const t = {_model('replay_caption')}.text; "
+        f"return t.includes('step {k} of') ? t : null }})()"
+    )
+    assert f"of {len(ro['steps']) - 1}" in caption
+    x = cdp.js(f"{_model('src:replay_robot')}.data.x[0]")
+    assert x == pytest.approx(ro["steps"][k]["pose"][0])
+    n_beams = cdp.js(f"{_model('src:replay_beams')}.data.x1.length")
+    assert n_beams == len(ro["steps"][k]["beams"][0]) > 0

@@ -73,16 +73,16 @@ def main(argv: list[str] | None = None) -> int:
             "fov": None if args.fov_deg is None else math.radians(args.fov_deg),
         }
         settings = Settings.from_scene(scene, **over)
-        if args.export:
-            from .export import export_html
-
-            path = export_html(scene, args.export, settings)
-            print(f"wrote {path} ({path.stat().st_size / 1e6:.1f} MB, self-contained)")
-            return 0
         if args.rollout:
             from .replay import load_rollout
 
-            load_rollout(args.rollout)  # fail early on a bad file
+            args.rollout = load_rollout(args.rollout)  # fail early on a bad file
+        if args.export:
+            from .export import export_html
+
+            path = export_html(scene, args.export, settings, rollout=args.rollout)
+            print(f"wrote {path} ({path.stat().st_size / 1e6:.1f} MB, self-contained)")
+            return 0
         from .app import serve
 
         serve(scene, settings, port=args.port, show=not args.no_browser, rollout=args.rollout)

@@ -3,7 +3,8 @@
 The scene and all five precomputed layers (:data:`layers.LAYERS`), each toggled by a
 checkbox or by clicking its legend entry; pan, wheel zoom, box zoom; hovering a
 region lists every layer under the cursor with its area.  BokehJS is inlined
-(``bokeh.resources.INLINE``), so the file opens offline.
+(``bokeh.resources.INLINE``), so the file opens offline.  With a saved rollout
+(:mod:`.replay`) a second tab replays it.
 """
 
 from __future__ import annotations
@@ -85,12 +86,26 @@ def export_html(
     settings: Settings | None = None,
     *,
     unit: str = "m",
+    rollout: str | Path | dict | None = None,
 ) -> Path:
-    """Write the self-contained HTML view of ``scene`` to ``path``; returns the path."""
+    """Write the self-contained HTML view of ``scene`` to ``path``; returns the path.
+    With ``rollout`` (a file of :mod:`.replay` or its dict) a second tab replays it."""
     from bokeh.embed import file_html
     from bokeh.resources import INLINE
 
     layout, _ = export_layout(scene, settings, unit=unit)
+    if rollout is not None:
+        from bokeh.models import TabPanel, Tabs
+
+        from .replay import replay_layout
+
+        layout = Tabs(
+            tabs=[
+                TabPanel(child=layout, title="Scene and regions"),
+                TabPanel(child=replay_layout(rollout, unit=unit), title="Replay"),
+            ],
+            name="tabs",
+        )
     text = file_html(layout, resources=INLINE, title=f"sensorplan view: {scene.name}")
     p = Path(path)
     p.write_text(text, encoding="utf-8")
