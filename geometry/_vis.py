@@ -271,14 +271,9 @@ def gaps_many(
         width[has] = np.minimum(sectors[has, 1], TAU)
     if interior:
         w1 = w2 = along = np.full((n, 2), np.nan)
-        d = dom.vert[None, :, :] - q[:, None, :]
-        cols = [np.arctan2(d[..., 1], d[..., 0])]
     else:
         w1, w2, along = _blocking(dom, q)
-        d = dom.vert[None, :, :] - q[:, None, :]
-        cols = [np.where(np.abs(d).max(axis=2) > tol, np.arctan2(d[..., 1], d[..., 0]), np.nan)]
-    if extra is not None:
-        cols.append(extra)
+    cols = [] if extra is None else [extra]
     cols.append(
         np.stack(
             [
@@ -292,16 +287,9 @@ def gaps_many(
             axis=1,
         )
     )
-    ang = np.concatenate(cols, axis=1)
-    rel = (ang - start[:, None]) % TAU
-    rel = np.where(np.isnan(rel) | (rel >= width[:, None]) | (rel <= 0.0), np.inf, rel)
-    rel = np.sort(np.concatenate([np.zeros((n, 1)), rel, width[:, None]], axis=1), axis=1)
-    lo_r, hi_r = rel[:, :-1], rel[:, 1:]
-    with np.errstate(invalid="ignore"):
-        good = np.isfinite(hi_r) & (hi_r - lo_r > 1e-13)
-    owner, col = np.nonzero(good)
-    lo = start[owner] + lo_r[owner, col]
-    hi = start[owner] + hi_r[owner, col]
+    crit = np.concatenate(cols, axis=1)
+    sort = _visindex.sorted_gaps if _visindex.available() else _sorted_gaps
+    owner, lo, hi = sort(q, start, width, dom.vert, crit, tol, interior)
     mid = 0.5 * (lo + hi)
     open_ = np.ones(len(mid), dtype=bool)
     for w in (w1, w2):
@@ -335,6 +323,36 @@ def gaps_many(
             zip(*(np.split(x, cuts) for x in (lo, hi, seg, p0, p1)), strict=False)
         )
     ]
+
+
+def _sorted_gaps(
+    q: np.ndarray,
+    start: np.ndarray,
+    width: np.ndarray,
+    vert: np.ndarray,
+    crit: np.ndarray,
+    tol: float,
+    interior: bool,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Gaps of every viewpoint ``q[i]``: the directions to all vertices (those within
+    ``tol`` of ``q[i]`` dropped unless ``interior``) and the critical directions
+    ``crit[i]`` (NaN ignored), relative to ``start[i]``, inside ``(0, width[i])``,
+    sorted; consecutive ones more than 1e-13 apart bound a gap.  Returns ``owner, lo,
+    hi`` (flat, radians).  :func:`geometry.visindex.sorted_gaps` is the compiled twin."""
+    n = len(q)
+    d = vert[None, :, :] - q[:, None, :]
+    a = np.arctan2(d[..., 1], d[..., 0])
+    if not interior:
+        a = np.where(np.abs(d).max(axis=2) > tol, a, np.nan)
+    ang = np.concatenate([a, crit], axis=1)
+    rel = (ang - start[:, None]) % TAU
+    rel = np.where(np.isnan(rel) | (rel >= width[:, None]) | (rel <= 0.0), np.inf, rel)
+    rel = np.sort(np.concatenate([np.zeros((n, 1)), rel, width[:, None]], axis=1), axis=1)
+    lo_r, hi_r = rel[:, :-1], rel[:, 1:]
+    with np.errstate(invalid="ignore"):
+        good = np.isfinite(hi_r) & (hi_r - lo_r > 1e-13)
+    owner, col = np.nonzero(good)
+    return owner, start[owner] + lo_r[owner, col], start[owner] + hi_r[owner, col]
 
 
 def _first_hits(
