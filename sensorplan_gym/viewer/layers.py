@@ -287,3 +287,42 @@ def _aim(layers: Layers, x: float, y: float) -> tuple[float | None, bool | None]
         return None, True
     psi = world.best_aim(x, y)
     return float(psi), bool(world.aim_ok(x, y, psi))
+
+
+def main(argv: list[str] | None = None) -> int:
+    """``python -m sensorplan_gym.viewer.layers [SCENE ...]``: the viewer's layer and probe
+    timings (medians of ``--repeat`` runs, milliseconds) -- what the live app re-runs on
+    every edit."""
+    import argparse
+    import statistics
+
+    from sensorplan_gym.core.world import load_scene
+
+    ap = argparse.ArgumentParser(prog="python -m sensorplan_gym.viewer.layers")
+    ap.add_argument("scenes", nargs="*", default=["lab"])
+    ap.add_argument("--model", choices=MODELS, default="complete")
+    ap.add_argument("--motion", choices=MOTIONS, default="translating")
+    ap.add_argument("--repeat", type=int, default=5)
+    args = ap.parse_args(argv)
+    print(f"model={args.model} motion={args.motion}; median of {args.repeat} runs, ms")
+    print(f"{'scene':<10}" + "".join(f"{k:>14}" for k in LAYERS) + f"{'probe':>10}")
+    for name in args.scenes:
+        scene = load_scene(name)
+        settings = Settings.from_scene(scene, model=args.model, motion=args.motion)
+        runs = [compute_layers(scene, settings) for _ in range(args.repeat)]
+        cells = []
+        for k in LAYERS:
+            if k in runs[0].geoms:
+                cells.append(f"{statistics.median(r.ms[k] for r in runs):>14.1f}")
+            else:
+                cells.append(f"{'n/a':>14}")
+        rng = np.random.default_rng(0)
+        lo, hi = scene.bounds.min(axis=0), scene.bounds.max(axis=0)
+        pts = rng.uniform(lo, hi, size=(50, 2))
+        pm = statistics.median(probe(runs[0], x, y)["ms"] for x, y in pts)
+        print(f"{name:<10}" + "".join(cells) + f"{pm:>10.2f}")
+    return 0
+
+
+if __name__ == "__main__":  # pragma: no cover
+    raise SystemExit(main())
