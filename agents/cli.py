@@ -78,10 +78,11 @@ def build_parser() -> argparse.ArgumentParser:
     t.add_argument("--eval-episodes", type=int, default=None)
     t.add_argument(
         "--vec-env",
-        choices=("auto", "subproc", "dummy"),
+        choices=("batched", "auto", "subproc", "dummy"),
         default=None,
-        help="auto: SubprocVecEnv when n_envs > 1 on a multi-core machine "
-        "(default: the config's vec_env, else auto)",
+        help="batched (= auto): all envs in one native vector env of the batched core; "
+        "dummy/subproc: SB3's DummyVecEnv/SubprocVecEnv of single envs "
+        "(default: the config's vec_env, else batched)",
     )
     t.add_argument(
         "--threads", type=int, default=1, help="torch threads (default 1; 0 keeps torch's default)"

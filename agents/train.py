@@ -58,6 +58,8 @@ __all__ = [
 ]
 
 CONFIG_DIR = Path(__file__).parent / "configs"
+#: how the training envs are vectorised (see :func:`train`)
+VEC_ENVS = ("batched", "auto", "dummy", "subproc")
 #: offset between the training seed and the periodic-evaluation env's seed
 EVAL_SEED_OFFSET = 10_000
 _META_KEYS = (
@@ -262,9 +264,12 @@ def train(
 ) -> dict:
     """Train ``algo`` on ``env_id``; returns the resolved config with the output paths.
 
-    ``vec_env``: ``"auto"`` (SubprocVecEnv when ``n_envs > 1`` and the machine has more
-    than one core), ``"subproc"`` or ``"dummy"``; ``None`` takes the config's ``vec_env``
-    (default ``"auto"``).  ``threads``: torch intra-op threads (default 1: on a small
+    ``vec_env``: ``"batched"`` (the default, also what ``"auto"`` means: all ``n_envs``
+    sub-envs in one native vector env of the batched core, seen through
+    :class:`agents.vecenv.BatchedVecEnv`), ``"dummy"`` (SB3's DummyVecEnv of single envs, the
+    previous path) or ``"subproc"`` (one process per env); ``None`` takes the config's
+    ``vec_env``.  The three give sub-env ``i`` the same episodes (seed ``seed + i``).
+    ``threads``: torch intra-op threads (default 1: on a small
     machine shared with the env workers, more threads make PPO's small-MLP updates
     many times *slower*).  ``progress_bar`` / ``tensorboard``:
     ``None`` turns them on when tqdm+rich / tensorboard are importable.
@@ -298,10 +303,10 @@ def train(
     n_eval = int(eval_episodes if eval_episodes is not None else hp.pop("n_eval_episodes", 10))
     hp.pop("n_eval_episodes", None)
     policy = hp.pop("policy", "MlpPolicy")
-    cfg_vec = hp.pop("vec_env", "auto")
+    cfg_vec = hp.pop("vec_env", "batched")
     vec_env = vec_env or cfg_vec
-    if vec_env not in ("auto", "subproc", "dummy"):
-        raise ValueError(f"vec_env must be auto, subproc or dummy, got {vec_env!r}")
+    if vec_env not in VEC_ENVS:
+        raise ValueError(f"vec_env must be one of {', '.join(VEC_ENVS)}, got {vec_env!r}")
     if n_envs < 1 or n_timesteps < 1:
         raise ValueError("--n-envs and --timesteps must be positive")
     hyperparams = copy.deepcopy(hp)  # as written in the YAML, for the record
@@ -312,10 +317,21 @@ def train(
     out.mkdir(parents=True, exist_ok=True)
 
     if vec_env == "auto":
-        vec_env = "subproc" if n_envs > 1 and _subproc_ok() else "dummy"
-    vec_cls = SubprocVecEnv if vec_env == "subproc" else DummyVecEnv
+        vec_env = "batched"
     make = _make_env_fn(env_id, resolved_env_kwargs)
-    venv = make_vec_env(make, n_envs=n_envs, seed=seed, vec_env_cls=vec_cls)
+    if vec_env == "batched":
+        from stable_baselines3.common.vec_env import VecMonitor
+
+        from .vecenv import BatchedVecEnv, make_batched_vec_env
+
+        venv = VecMonitor(
+            make_batched_vec_env(env_id, n_envs, seed=seed, env_kwargs=resolved_env_kwargs)
+        )
+        vec_name = BatchedVecEnv.__name__
+    else:
+        vec_cls = SubprocVecEnv if vec_env == "subproc" else DummyVecEnv
+        venv = make_vec_env(make, n_envs=n_envs, seed=seed, vec_env_cls=vec_cls)
+        vec_name = vec_cls.__name__
     eval_env = make_vec_env(make, n_envs=1, seed=seed + EVAL_SEED_OFFSET, vec_env_cls=DummyVecEnv)
 
     kwargs = dict(hp)
@@ -399,7 +415,7 @@ def train(
     if verbose:
         print(
             f"training {algo.upper()} on {env_id} {resolved_env_kwargs} for {n_timesteps} steps, "
-            f"seed {seed}, {n_envs} x {vec_cls.__name__} -> {out}",
+            f"seed {seed}, {n_envs} x {vec_name} -> {out}",
             flush=True,
         )
     try:

@@ -175,9 +175,8 @@ def test_random_scene_pool_deterministic_and_shared():
     assert 1 < len(names) <= 4  # drawn from the pool of 4
     b = _vec("sensorplan/Navigate-v0", 6, **kw)
     b.reset(seed=0)
-    assert [w is v for w, v in zip(venv.unwrapped.batch.worlds, b.unwrapped.batch.worlds)] == [
-        True
-    ] * 6
+    pairs = zip(venv.unwrapped.batch.worlds, b.unwrapped.batch.worlds, strict=True)
+    assert all(w is v for w, v in pairs)
     other = _vec("sensorplan/Navigate-v0", 6, scene="random", scene_pool_size=4, scene_pool_seed=2)
     other.reset(seed=0)
     mine = {id(w) for w in venv.unwrapped.batch.worlds}
