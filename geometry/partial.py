@@ -337,5 +337,11 @@ def _fans(g: Gaps, mask: np.ndarray, dom: Domain, eps_aim: float) -> list[shapel
             pts[0] = g.q
             pts[1::2] = g.p0[piece]
             pts[2::2] = g.p1[piece]
-            out.append(clean_polygon(pts, 1e-10 * dom.scale))
+            # adjacent gaps ending on the same segment continue one straight edge: keep
+            # only the ends of such runs (fewer vertices for the union, same polygon)
+            same = g.seg[piece[1:]] == g.seg[piece[:-1]]
+            keep = np.ones(len(pts), dtype=bool)
+            keep[2:-1:2] = ~same
+            keep[3::2] = ~same
+            out.append(clean_polygon(pts[keep], 1e-10 * dom.scale))
     return out
