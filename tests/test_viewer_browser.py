@@ -253,6 +253,22 @@ def _model(name: str) -> str:
     return f"{DOC}.get_model_by_name({json.dumps(name)})"
 
 
+#: JS: page pixel (CSS px) of a world point (x, y) in the scene figure
+PIXEL = """(x, y) => { const fig = Bokeh.documents[0].get_model_by_name('scene_figure');
+let found = null;
+const walk = (v) => {
+  if (v.model === fig) found = v;
+  for (const c of (v.child_views || [])) walk(c) };
+for (const r of Bokeh.index.roots) walk(r);
+const f = found.frame; const el = found.el.getBoundingClientRect();
+return [el.left + f.x_scale.compute(x), el.top + f.y_scale.compute(y)] }"""
+
+
+def _pixel(cdp: _CDP, x: float, y: float) -> tuple[float, float]:
+    px, py = cdp.js(f"({PIXEL})({x}, {y})")
+    return float(px), float(py)
+
+
 def test_served_app_edit_in_chromium(served, tmp_path):
     url, cdp = served
     cdp.call("Page.enable")
@@ -288,23 +304,46 @@ def test_served_app_edit_in_chromium(served, tmp_path):
     )
     assert "sees A in G" in info and "sees A in H" in info and "query" in info
     assert cdp.js(f"{_model('src:vis')}.data.xs.length") == 1  # its visibility polygon
-    # edit in the browser: move obstacle 2 (3.6..5.6 x 2.4..3.2) one metre to the right
+    # edit with the mouse: the edit-vertices tool, press and hold obstacle 2
+    # (3.6..5.6 x 2.4..3.2) until its vertices show, drag its corner (5.6, 2.4) one metre right
     cdp.js(
-        f"(() => {{ const s = {_model('src:obstacles')}; "
-        f"{COPY_XY}"
-        "xs[2] = xs[2].map(v => v + 1.0); s.data = {xs: xs, ys: ys}; return true })()"
+        f"{_model('scene_figure')}.toolbar.tools.find(t => t.type == 'PolyEditTool')"
+        ".active = true; true"
     )
+    cx, cy = _pixel(cdp, 4.6, 2.8)
+    cdp.call("Input.dispatchMouseEvent", type="mouseMoved", x=cx, y=cy)
+    cdp.call("Input.dispatchMouseEvent", type="mousePressed", x=cx, y=cy, button="left",
+             clickCount=1)  # fmt: skip
+    time.sleep(0.7)  # a press is a hold of > 300 ms
+    cdp.call("Input.dispatchMouseEvent", type="mouseReleased", x=cx, y=cy, button="left",
+             clickCount=1)  # fmt: skip
+    cdp.wait_js(f"{_model('edit:vertices')}.data_source.data.x.length == 4")
+    vx, vy = _pixel(cdp, 5.6, 2.4)
+    tx, _ = _pixel(cdp, 6.6, 2.4)
+    cdp.call("Input.dispatchMouseEvent", type="mouseMoved", x=vx, y=vy)
+    cdp.call("Input.dispatchMouseEvent", type="mousePressed", x=vx, y=vy, button="left",
+             clickCount=1)  # fmt: skip
+    for i in range(1, 11):
+        cdp.call("Input.dispatchMouseEvent", type="mouseMoved", x=vx + (tx - vx) * i / 10, y=vy,
+                 button="left", buttons=1)  # fmt: skip
+        time.sleep(0.03)
+    cdp.call("Input.dispatchMouseEvent", type="mouseReleased", x=tx, y=vy, button="left",
+             clickCount=1)  # fmt: skip
     a1 = cdp.wait_js(
         f"(() => {{ const a = {area_js}; return (a !== null && Math.abs(a - {a0}) > 1e-6) ? a "
         ": null })()"
     )
+    xs = cdp.js(f"Array.from({_model('src:obstacles')}.data.xs[2])")
+    ys = cdp.js(f"Array.from({_model('src:obstacles')}.data.ys[2])")
+    assert xs[1] == pytest.approx(6.6, abs=0.05) and ys[1] == pytest.approx(2.4, abs=0.05)
     from geometry import recognizable_region
     from sensorplan_gym.core.world import load_scene
 
     scene = load_scene("lab")
     d = scene.to_dict()
-    d["obstacles"][2] = [[x + 1.0, y] for x, y in d["obstacles"][2]]
+    d["obstacles"][2] = [[x, y] for x, y in zip(xs, ys, strict=True)]
     moved = scene.from_dict(d)
+    # the server's region is the exact region of the scene as edited in the browser
     assert a1 == pytest.approx(recognizable_region(moved).area, rel=1e-9)
     # an invalid edit: an obstacle over G is reported, not applied, and nothing crashes
     cdp.js(

@@ -7,7 +7,7 @@ What it does
 * controls for the visibility model, the target motion, ``eps_pos`` (scene units),
   ``eps_aim`` and the field of view (degrees);
 * drag-to-edit: the vertices of the walls, obstacles, G, H and the target
-  (``PolyEditTool``: double-click a shape, then drag its vertices; ``PolyDrawTool``
+  (``PolyEditTool``: press and hold a shape, then drag its vertices; ``PolyDrawTool``
   adds obstacles; ``PointDrawTool`` moves the start and point-shaped G/H); every edit
   rebuilds the :class:`geometry.Scene` and recomputes the checked layers exactly,
   and the page says how long that took;
@@ -149,7 +149,7 @@ class ViewerApp:
         self.target_at = _anchor(self.scene.goal_geom)
         self.layers = self._compute(self.scene) or self.layers
         sf = build_figure(
-            self.scene, self.layers, visible=self.visible, unit=self.unit, width=1000, hover=False
+            self.scene, self.layers, visible=self.visible, unit=self.unit, width=920, hover=False
         )
         self.sf = sf
         fig = sf.fig
@@ -183,14 +183,14 @@ class ViewerApp:
         vtx = fig.scatter([], [], size=9, color="#ff7f0e", name="edit:vertices")
         editable = [
             sf.renderers[k]
-            for k in ("bounds", "obstacles", "goal", "failure", "target")
+            for k in ("obstacles", "goal", "failure", "target", "bounds")
             if sf.renderers[k].glyph.__class__.__name__ == "Patches"
         ]
         fig.add_tools(
             PolyEditTool(
                 renderers=editable,
                 vertex_renderer=vtx,
-                description="Edit vertices (double-click a shape)",
+                description="Edit vertices (press and hold a shape, drag its vertices)",
             )
         )
         fig.add_tools(
@@ -281,9 +281,11 @@ class ViewerApp:
 
         help_div = Div(
             text=(
-                "<b>Edit</b>: pick the <i>edit vertices</i> tool, double-click a shape "
-                "(walls, obstacle, G, H, target), drag its orange vertices. New obstacle: "
-                "<i>draw</i> tool. Invalid scenes are reported, not applied."
+                "<b>Edit</b>: pick the <i>edit vertices</i> tool, press and hold a shape "
+                "(obstacle, G, H, target, walls) until its vertices show (orange), then drag "
+                "them; Backspace deletes a selected vertex. New obstacle: the <i>draw</i> tool "
+                "(click the corners, double-click to close). Invalid scenes are reported, "
+                "not applied."
             ),
             width=330,
         )
@@ -382,7 +384,7 @@ class ViewerApp:
                         self._syncing = False
         self._push_layers()
         self._show_status()
-        if self.pinned and self.probe_src.data["x"]:
+        if self.probe_src.data["x"]:  # the probed placement, against the new scene
             self.probe_at(self.probe_src.data["x"][0], self.probe_src.data["y"][0])
 
     def _data(self) -> dict[str, dict[str, list]]:
