@@ -40,6 +40,7 @@ FLAGS = [
     "--disable-component-update",
     "--disable-sync",
     "--hide-scrollbars",
+    "--disable-dev-shm-usage",
 ]
 REPO = Path(__file__).resolve().parents[1]
 LAYER_KEYS = ("partial_G", "partial_H", "complete_G", "complete_H", "recognizable")

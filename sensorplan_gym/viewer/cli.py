@@ -55,7 +55,7 @@ def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     try:
         import bokeh  # noqa: F401
-    except ModuleNotFoundError:
+    except ImportError:
         print('sensorplan view: error: needs Bokeh: pip install -e ".[viewer]"', file=sys.stderr)
         return 2
     from geometry import SceneError
