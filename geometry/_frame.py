@@ -85,16 +85,33 @@ class Frame:
     # -- local -> world ----------------------------------------------------------------------
 
     def to_world(self, g: shapely.Geometry) -> shapely.Geometry:
-        """A shapely geometry, local -> world (one rounding per coordinate)."""
+        """A shapely geometry, local -> world (one rounding per coordinate).
+
+        Rounding can fold a sliver of a valid polygon (two vertices closer than the world
+        coordinates' last bit): such a result is repaired (``make_valid``, areal parts
+        kept), which moves no boundary by more than that last bit."""
         if self.identity:
             return g
-        return shapely.transform(g, lambda c: c * self.scale + np.array([self.ox, self.oy]))
+        w = shapely.transform(g, lambda c: c * self.scale + np.array([self.ox, self.oy]))
+        if w.is_empty or w.is_valid or g.geom_type not in ("Polygon", "MultiPolygon"):
+            return w
+        return _areal(shapely.make_valid(w))
 
     def to_world_pts(self, p: np.ndarray) -> np.ndarray:
         return np.asarray(p, dtype=float) * self.scale + np.array([self.ox, self.oy])
 
 
 IDENTITY = Frame(0.0, 0.0, 1.0)
+
+
+def _areal(g: shapely.Geometry) -> shapely.Geometry:
+    """The polygonal parts of ``g`` as one Polygon/MultiPolygon (empty Polygon if none)."""
+    parts = shapely.get_parts(g)
+    parts = parts[np.isin(shapely.get_type_id(parts), (3, 6))]
+    if len(parts) == 0:
+        return shapely.Polygon()
+    u = shapely.union_all(parts)
+    return u if u.geom_type in ("Polygon", "MultiPolygon") else _areal(u)
 
 
 def frame_params(pts: np.ndarray) -> Frame:

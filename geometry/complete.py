@@ -114,7 +114,8 @@ def _complete(scene: Scene, spec: TargetSpec) -> shapely.Geometry:
         # A wedge side bounds the region only if the obstacle stays on one side of
         # it at u (otherwise the tangent enters the obstacle right at u).
         prev, nxt = dom.vert_prev[dom.reflex], dom.vert_next[dom.reflex]
-        wedges = wedges[_grazes(u, k_lo, prev, nxt) | _grazes(u, k_hi, prev, nxt)]
+        tol = 1e-9 * dom.scale
+        wedges = wedges[_grazes(u, k_lo, prev, nxt, tol) | _grazes(u, k_hi, prev, nxt, tol)]
     if len(wedges):
         shapely.prepare(vis)
         wedges = wedges[shapely.intersects(vis, wedges)]
@@ -257,10 +258,17 @@ def _tangent_point(u: np.ndarray, ang: np.ndarray, k: np.ndarray, radius: float)
     return u + ((k - u) * e).sum(axis=1)[:, None] * e
 
 
-def _grazes(u: np.ndarray, k: np.ndarray, prev: np.ndarray, nxt: np.ndarray) -> np.ndarray:
+def _grazes(
+    u: np.ndarray, k: np.ndarray, prev: np.ndarray, nxt: np.ndarray, tol: float = 0.0
+) -> np.ndarray:
     """True where the line through ``u`` and ``k`` has both ring neighbours of
-    ``u`` on the same (closed) side."""
+    ``u`` on the same (closed) side.  A neighbour within ``tol`` of the line counts
+    as on it (an obstacle flush on a hull edge, touching within the scene's
+    tolerance: keeping the wedge is the conservative choice)."""
     d = k - u
+    ln = np.hypot(d[:, 0], d[:, 1])
     a = d[:, 0] * (prev - u)[:, 1] - d[:, 1] * (prev - u)[:, 0]
     b = d[:, 0] * (nxt - u)[:, 1] - d[:, 1] * (nxt - u)[:, 0]
+    a = np.where(np.abs(a) <= tol * ln, 0.0, a)
+    b = np.where(np.abs(b) <= tol * ln, 0.0, b)
     return a * b >= 0

@@ -150,9 +150,12 @@ def _partial_region(
     spec = target_spec(scene, target_at, None, theta)
     ring = _hole_ring(spec.area)
     region = weak_visibility(scene_domain(scene), ring, np.ones(len(ring), dtype=bool), eps_aim)
-    region = polygonal(shapely.difference(region, spec.area))
+    # clipped to the free space: an anchor on a target edge that lies flush against an
+    # obstacle (touching within the scene's tolerance) may be inside that obstacle by
+    # rounding, and its fan then fills the obstacle (issue 10, fuzz seed 223)
+    allowed = shapely.difference(scene.free_space, spec.area)
+    region = polygonal(shapely.intersection(region, allowed))
     if eps_pos > 0:
-        allowed = shapely.difference(scene.free_space, spec.area)
         region = shrink_for_position(region, allowed, eps_pos)
     return region
 

@@ -1,0 +1,561 @@
+"""Fuzzing the region functions on degenerate scenes (issue 10).
+
+:func:`fuzz_scene` draws a *valid-looking* scene dictionary full of the contacts that
+exact geometry gets wrong: obstacles flush on walls (vertices interpolated on the wall,
+so off it by rounding), obstacles sharing edges or vertices, T-junctions (a vertex on
+another polygon's edge), collinear edges, slivers (aspect ratio down to 1e-7), obstacles
+touching the convex hull of the target at G (at a vertex or flush on an edge), non-convex
+rooms, coordinates rounded to 6 decimals, and scales from 1e-6 to 1e6.  Coordinates are
+snapped to a dyadic grid of ``2**-32`` of the scene's size so that translating the scene
+by a multiple of its size (up to ~1e6 sizes) is *exact*: the translation check then
+demands equality up to the output's rounding.
+
+:func:`check_scene` runs every query type on one scene and returns the violations:
+
+* ``crash``: an exception other than :class:`~geometry.SceneError` /
+  ``NotImplementedError`` (``SceneError`` is the documented answer for a query that
+  violates the paper's assumption, e.g. a rotated target whose hull meets an obstacle);
+* ``invalid``: not a valid shapely Polygon/MultiPolygon;
+* ``outside``: area outside the free space (or inside the target) above 1e-9 D^2;
+* ``inclusion``: complete ⊆ partial, translating ⊆ stationary at every vertex of G, any
+  orientation ⊆ fixed orientation, recognizable ⊆ both complete regions, swept partial
+  (``conservative=True``) ⊆ stationary partial, violated by more than 1e-8 D^2;
+* ``unsafe``: a sampled member of a complete region that an independent segment test
+  finds blind to part of the target (points within 1e-6 D of the region's boundary are
+  skipped);
+* ``translation``: the region of the scene translated by an exact offset, translated
+  back, differs from the original by more than 1e-9 D^2;
+* ``hang``: a query that took more than 10 s (scenes of at most 60 edges).
+
+``python -m geometry.fuzz --n 10000 [--swept] [--seed 0]`` runs the long version and
+prints a table; ``tests/test_fuzz.py`` runs a fast one in the default test run.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+import time
+from collections import Counter
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import shapely
+
+from .complete import complete_region
+from .partial import partial_region
+from .recognize import recognizable_region
+from .scene import Scene, SceneError
+
+__all__ = ["Finding", "check_scene", "fuzz_scene", "main"]
+
+#: A query slower than this (seconds) is a hang.
+HANG_S = 10.0
+
+
+# ---------------------------------------------------------------------------------------------
+# scene generator
+# ---------------------------------------------------------------------------------------------
+
+
+def _star(rng: np.random.Generator, n: int, r0: float, r1: float) -> np.ndarray:
+    ang = np.sort(rng.uniform(0, 2 * math.pi, n))
+    ang += np.linspace(0, 2 * math.pi, n, endpoint=False) - ang  # keep them spread
+    ang += rng.uniform(-0.3, 0.3, n) * (2 * math.pi / n)
+    rad = rng.uniform(r0, r1, n)
+    return np.column_stack([rad * np.cos(ang), rad * np.sin(ang)])
+
+
+def _convex(rng: np.random.Generator, c: np.ndarray, size: float) -> np.ndarray:
+    pts = c + rng.uniform(-size, size, (int(rng.integers(3, 8)), 2))
+    hull = shapely.convex_hull(shapely.multipoints(pts))
+    if hull.geom_type != "Polygon":
+        return c + size * np.array([[0, 0], [1, 0], [0, 1.0]])
+    return np.asarray(hull.exterior.coords)[:-1]
+
+
+def _bounds(rng: np.random.Generator) -> np.ndarray:
+    kind = rng.integers(4)
+    if kind == 0:  # rectangle
+        w, h = rng.uniform(6, 14, 2)
+        return np.array([[0, 0], [w, 0], [w, h], [0, h]])
+    if kind == 1:  # star-shaped, non-convex
+        return _star(rng, int(rng.integers(5, 13)), 3.5, 7.0) + 7.0
+    if kind == 2:  # L-shape
+        w, h = rng.uniform(8, 14, 2)
+        a, b = rng.uniform(0.3, 0.7, 2)
+        return np.array([[0, 0], [w, 0], [w, b * h], [a * w, b * h], [a * w, h], [0, h]])
+    # U-shape
+    w, h = rng.uniform(9, 14, 2)
+    a, b, c = w * 0.35, w * 0.65, h * rng.uniform(0.3, 0.6)
+    return np.array([[0, 0], [w, 0], [w, h], [b, h], [b, c], [a, c], [a, h], [0, h]])
+
+
+def _on_segment(rng: np.random.Generator, a: np.ndarray, b: np.ndarray) -> tuple:
+    t0, t1 = np.sort(rng.uniform(0.1, 0.9, 2))
+    if t1 - t0 < 0.05:
+        t1 = min(t0 + 0.1, 0.95)
+    return a + t0 * (b - a), a + t1 * (b - a)
+
+
+def _inward(ring: np.ndarray, i: int) -> np.ndarray:
+    """Unit normal of edge i of a CCW ring pointing into the polygon."""
+    e = ring[(i + 1) % len(ring)] - ring[i]
+    n = np.array([-e[1], e[0]])
+    return n / np.hypot(*n)
+
+
+def _outward(ring: np.ndarray, i: int) -> np.ndarray:
+    return -_inward(ring, i)
+
+
+def _ccw(p: np.ndarray) -> np.ndarray:
+    x, y = p[:, 0], p[:, 1]
+    area = np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y)
+    return p if area > 0 else p[::-1]
+
+
+@dataclass
+class _Draft:
+    bounds: np.ndarray
+    obstacles: list[np.ndarray] = field(default_factory=list)
+    features: list[str] = field(default_factory=list)
+
+    def edges(self) -> int:
+        return len(self.bounds) + sum(len(o) for o in self.obstacles)
+
+
+def _add_obstacle(rng: np.random.Generator, dr: _Draft, size: float) -> None:
+    b = _ccw(dr.bounds)
+    kind = rng.choice(
+        [
+            "convex",
+            "rect",
+            "flush_wall",
+            "shared_edge",
+            "shared_vertex",
+            "t_junction",
+            "collinear",
+            "sliver",
+            "vertex_on_wall",
+        ]  # fmt: skip
+    )
+    if kind in ("shared_edge", "shared_vertex", "t_junction", "collinear") and not dr.obstacles:
+        kind = "convex"
+    if kind == "convex":
+        c = _sample_point(rng, dr.bounds)
+        dr.obstacles.append(_convex(rng, c, size * rng.uniform(0.3, 1.0)))
+    elif kind == "rect":
+        c = _sample_point(rng, dr.bounds)
+        w, h = size * rng.uniform(0.2, 1.0, 2)
+        dr.obstacles.append(c + np.array([[0, 0], [w, 0], [w, h], [0, h]]))
+    elif kind in ("flush_wall", "vertex_on_wall"):
+        i = int(rng.integers(len(b)))
+        p0, p1 = _on_segment(rng, b[i], b[(i + 1) % len(b)])
+        n = _inward(b, i) * size * rng.uniform(0.2, 0.8)
+        if kind == "flush_wall":
+            dr.obstacles.append(np.array([p0, p1, p1 + n, p0 + n]))
+        else:
+            m = 0.5 * (p0 + p1)
+            dr.obstacles.append(np.array([m, m + n + (p1 - p0) * 0.5, m + n - (p1 - p0) * 0.5]))
+    elif kind != "sliver":
+        o = _ccw(dr.obstacles[int(rng.integers(len(dr.obstacles)))])
+        i = int(rng.integers(len(o)))
+        a, c = o[i], o[(i + 1) % len(o)]
+        n = _outward(o, i) * size * rng.uniform(0.2, 0.8)
+        if kind == "shared_edge":
+            dr.obstacles.append(np.array([c, a, a + n, c + n]))
+        elif kind == "shared_vertex":
+            d = (c - a) / max(np.hypot(*(c - a)), 1e-300) * size * 0.5
+            dr.obstacles.append(np.array([c, c + n + d, c + d * 1.5]))
+        elif kind == "t_junction":
+            m = a + rng.uniform(0.2, 0.8) * (c - a)
+            d = (c - a) * 0.2
+            dr.obstacles.append(np.array([m, m + n + d, m + n - d]))
+        else:  # collinear: same line as edge (a, c), beyond c
+            d = c - a
+            p0 = c + d * rng.uniform(0.3, 1.0)
+            p1 = p0 + d * rng.uniform(0.2, 0.6)
+            dr.obstacles.append(np.array([p0, p1, p1 + n, p0 + n]))
+    if kind == "sliver":
+        c = _sample_point(rng, dr.bounds)
+        phi = rng.uniform(0, math.pi)
+        ln = size * rng.uniform(0.5, 1.5)
+        th = ln * 10.0 ** rng.uniform(-7, -3)
+        u = np.array([math.cos(phi), math.sin(phi)])
+        v = np.array([-u[1], u[0]])
+        dr.obstacles.append(np.array([c, c + ln * u, c + ln * u + th * v, c + th * v]))
+    dr.features.append(str(kind))
+
+
+def _sample_point(rng: np.random.Generator, ring: np.ndarray) -> np.ndarray:
+    poly = shapely.Polygon(ring)
+    x0, y0, x1, y1 = poly.bounds
+    for _ in range(200):
+        p = rng.uniform([x0, y0], [x1, y1])
+        if shapely.contains_xy(poly, *p):
+            return p
+    return np.asarray(poly.representative_point().coords[0])
+
+
+def _target(rng: np.random.Generator, r: float) -> np.ndarray:
+    kind = rng.integers(3)
+    if kind == 0:  # regular polygon (symmetric)
+        n = int(rng.integers(3, 9))
+        a = np.linspace(0, 2 * math.pi, n, endpoint=False) + rng.uniform(0, 1) * (kind == 0)
+        return r * np.column_stack([np.cos(a), np.sin(a)])
+    if kind == 1:  # convex
+        t = _convex(rng, np.zeros(2), r)
+        return t - np.asarray(shapely.Polygon(t).centroid.coords[0])
+    return _star(rng, int(rng.integers(5, 12)), 0.4 * r, r)  # star-shaped, non-convex
+
+
+def _place(rng: np.random.Generator, free: shapely.Geometry, clear: float) -> np.ndarray | None:
+    inner = free.buffer(-clear)
+    if inner.is_empty:
+        return None
+    x0, y0, x1, y1 = inner.bounds
+    for _ in range(100):
+        p = rng.uniform([x0, y0], [x1, y1])
+        if shapely.contains_xy(inner, *p):
+            return p
+    return None
+
+
+def _region(rng: np.random.Generator, c: np.ndarray, size: float) -> list[list[float]]:
+    kind = rng.integers(3)
+    if kind == 0:
+        return [c.tolist()]
+    if kind == 1:
+        s = size
+        return (c + np.array([[-s, -s], [s, -s], [s, s], [-s, s]])).tolist()
+    return (c + _star(rng, int(rng.integers(4, 7)), 0.5 * size, size)).tolist()
+
+
+def _snap(v: Any, grid: float) -> Any:
+    if isinstance(v, list):
+        return [_snap(x, grid) for x in v]
+    return float(np.round(v / grid) * grid)
+
+
+def fuzz_scene(seed: int, *, max_edges: int = 60) -> dict[str, Any] | None:
+    """A random degenerate scene dictionary (or ``None`` when the draw failed to give a
+    valid scene after a few tries).  ``"features"`` (not a scene key; removed before
+    use) lists the degeneracies drawn."""
+    rng = np.random.default_rng(seed)
+    for _ in range(8):
+        d = _draft_scene(rng, max_edges)
+        if d is None:
+            continue
+        try:
+            Scene.from_dict({k: v for k, v in d.items() if k != "features"})
+        except SceneError:
+            continue
+        return d
+    return None
+
+
+def _draft_scene(rng: np.random.Generator, max_edges: int) -> dict[str, Any] | None:
+    dr = _Draft(_bounds(rng))
+    diam = float(np.hypot(*np.ptp(dr.bounds, axis=0)))
+    for _ in range(int(rng.integers(0, 8))):
+        if dr.edges() > max_edges - 12:
+            break
+        _add_obstacle(rng, dr, diam * rng.uniform(0.05, 0.2))
+    bpoly = shapely.Polygon(dr.bounds)
+    obs = [shapely.Polygon(o) for o in dr.obstacles]
+    obs = [o for o in obs if o.is_valid and o.area > 0 and bpoly.buffer(1e-9 * diam).covers(o)]
+    dr.obstacles = [np.asarray(o.exterior.coords)[:-1] for o in obs]
+    free = bpoly.difference(shapely.union_all(obs)) if obs else bpoly
+    r = diam * rng.uniform(0.01, 0.05)
+    target = _target(rng, r)
+    size = r * rng.uniform(0.5, 3.0)
+    pg = _place(rng, free, 1.2 * r + 1.5 * size)
+    if pg is None:
+        return None
+    goal = _region(rng, pg, size)
+    gpoly = shapely.Polygon(goal) if len(goal) > 1 else shapely.Point(goal[0])
+    pf = _place(rng, free.difference(gpoly.buffer(2 * r + 2 * size)), 1.2 * r + 1.5 * size)
+    if pf is None:
+        return None
+    failure = _region(rng, pf, size)
+    if rng.random() < 0.3 and len(goal) == 1:
+        # touch_hull: a triangle touching the target at G at a vertex or flush on an edge
+        a = _ccw(target + np.asarray(goal[0]))
+        i = int(rng.integers(len(a)))
+        p, q = a[i], a[(i + 1) % len(a)]
+        n = _outward(a, i) * r
+        if rng.random() < 0.5:
+            tri = np.array([q, p, p + n])  # flush on the edge
+        else:
+            tri = np.array([p, p + n + (q - p) * 0.5, p + n - (q - p) * 0.5])
+        dr.obstacles.append(tri)
+        dr.features.append("touch_hull")
+    d: dict[str, Any] = {
+        "name": "fuzz",
+        "bounds": dr.bounds.tolist(),
+        "obstacles": [o.tolist() for o in dr.obstacles],
+        "target": target.tolist(),
+        "goal": goal,
+        "failure": failure,
+    }
+    if rng.random() < 0.3:
+        for k in ("bounds", "obstacles", "target", "goal", "failure"):
+            d[k] = _snap(d[k], 1e-6)  # coordinates written to 6 decimals
+        dr.features.append("rounded")
+    scale = 10.0 ** float(rng.choice([0.0, 0.0, rng.uniform(-6, 6)]))
+    if scale != 1.0:
+        dr.features.append("scaled")
+    grid = math.ldexp(1.0, math.ceil(math.log2(diam * scale)) - 32)
+    for k in ("bounds", "goal", "failure", "obstacles"):
+        d[k] = _snap(_scaled(d[k], scale), grid)
+    d["target"] = _snap(_scaled(d["target"], scale), grid)
+    d["name"] = "fuzz"
+    d["features"] = dr.features
+    return d
+
+
+def _scaled(v: Any, k: float) -> Any:
+    if isinstance(v, list):
+        return [_scaled(x, k) for x in v]
+    return v * k
+
+
+# ---------------------------------------------------------------------------------------------
+# checks
+# ---------------------------------------------------------------------------------------------
+
+
+@dataclass
+class Finding:
+    kind: str
+    query: str
+    detail: str
+
+
+def _timed(fn: Callable[[], Any], name: str, out: list[Finding], times: dict) -> Any:
+    t0 = time.perf_counter()
+    try:
+        r = fn()
+    except (SceneError, NotImplementedError):
+        r = None
+    except Exception as e:  # noqa: BLE001 -- the point of the fuzzer
+        out.append(Finding("crash", name, f"{type(e).__name__}: {e}"))
+        r = None
+    dt = time.perf_counter() - t0
+    times[name] = dt
+    if dt > HANG_S:
+        out.append(Finding("hang", name, f"{dt:.1f} s"))
+    return r
+
+
+def _sees_whole(obs: shapely.Geometry, walls: shapely.Geometry, hull: np.ndarray, p) -> bool:
+    ts = np.linspace(0, 1, 24, endpoint=False)
+    ring = np.vstack([hull, hull[:1]])
+    pts = (ring[:-1, None, :] + ts[None, :, None] * (ring[1:] - ring[:-1])[:, None, :]).reshape(
+        -1, 2
+    )
+    lines = shapely.linestrings(np.stack([np.broadcast_to(p, pts.shape), pts], axis=1))
+    if not obs.is_empty and shapely.intersects(lines, obs).any():
+        return False
+    return bool(shapely.covers(walls, lines).all())
+
+
+def _sample(g: shapely.Geometry, n: int, rng: np.random.Generator, margin: float) -> np.ndarray:
+    core = g.buffer(-margin)
+    if core.is_empty:
+        return np.empty((0, 2))
+    x0, y0, x1, y1 = core.bounds
+    p = rng.uniform([x0, y0], [x1, y1], (40 * n, 2))
+    return p[shapely.contains_xy(core, p[:, 0], p[:, 1])][:n]
+
+
+def _translated(d: dict, o: float) -> dict:
+    out = dict(d)
+    for k in ("bounds", "goal", "failure"):
+        out[k] = [[x + o, y + o] for x, y in d[k]]
+    out["obstacles"] = [[[x + o, y + o] for x, y in ob] for ob in d["obstacles"]]
+    return out
+
+
+def check_scene(
+    d: dict[str, Any], *, swept: bool = False, translate: bool = True, seed: int = 0
+) -> tuple[list[Finding], dict[str, float]]:
+    """Run every query type on the scene dictionary ``d`` (see the module docstring);
+    returns the findings and the time of every query (seconds)."""
+    d = {k: v for k, v in d.items() if k != "features"}
+    s = Scene.from_dict(d)
+    rng = np.random.default_rng(seed)
+    out: list[Finding] = []
+    times: dict[str, float] = {}
+    D = s.diameter
+    area_tol = 1e-8 * D * D
+    free = s.free_space
+    theta = float(rng.uniform(-math.pi, math.pi)) if rng.random() < 0.5 else 0.0
+    q0 = (float(s.goal[0, 0]), float(s.goal[0, 1]), 0.0)
+    point_gh = len(s.goal) == 1 and len(s.failure) == 1
+    poly_gh = len(s.goal) > 1 and len(s.failure) > 1
+
+    def run(name: str, fn: Callable[[], Any]) -> Any:
+        r = _timed(fn, name, out, times)
+        if r is None:
+            return None
+        if r.geom_type not in ("Polygon", "MultiPolygon") or not r.is_valid:
+            out.append(Finding("invalid", name, f"{r.geom_type}, {shapely.is_valid_reason(r)}"))
+            return None
+        extra = shapely.difference(r, free).area
+        if extra > 1e-9 * D * D:
+            out.append(Finding("outside", name, f"{extra / D**2:.3g} D^2 outside the free space"))
+        return r
+
+    def incl(a: Any, b: Any, what: str) -> None:
+        if a is None or b is None:
+            return
+        diff = shapely.difference(a, b).area
+        if diff > area_tol:
+            out.append(Finding("inclusion", what, f"{diff / D**2:.3g} D^2"))
+
+    q_at = (q0[0], q0[1], theta)
+    c_at = run("complete at", lambda: complete_region(s, target_at=q_at))
+    p_at = run("partial at", lambda: partial_region(s, target_at=q_at))
+    incl(c_at, p_at, "complete at ⊆ partial at")
+    if c_at is not None:
+        inside_t = shapely.intersection(c_at, s.target_at(*q_at)).area
+        if inside_t > 1e-9 * D * D:
+            out.append(Finding("outside", "complete at", f"{inside_t / D**2:.3g} D^2 in target"))
+        obs = s.obstacle_union.buffer(-1e-9 * D, join_style="mitre")
+        walls = s.bounds_geom.buffer(1e-9 * D, join_style="mitre")
+        hull = np.asarray(s.target_at(*q_at).convex_hull.exterior.coords)[:-1]
+        pts = _sample(c_at, 12, rng, 1e-6 * D)
+        blind = sum(not _sees_whole(obs, walls, hull, p) for p in pts)
+        if blind:
+            out.append(Finding("unsafe", "complete at", f"{blind} of {len(pts)} members blind"))
+    c_in = run("complete in", lambda: complete_region(s, target_in="goal", theta=theta))
+    c_any = run("complete any", lambda: complete_region(s, target_in="goal", theta=None))
+    incl(c_any, c_in, "any orientation ⊆ fixed orientation")
+    verts = s.goal if len(s.goal) > 1 else s.goal[:1]
+    for v in verts[:4]:
+        cv = _timed(
+            lambda v=v: complete_region(s, target_at=(v[0], v[1], theta)), "complete at v", out, {}
+        )
+        incl(c_in, cv, "translating ⊆ stationary (complete)")
+    rc = run("recognizable complete", lambda: recognizable_region(s, theta=theta))
+    incl(rc, c_in, "recognizable ⊆ complete in G")
+    if point_gh:
+        rp = run("recognizable partial", lambda: recognizable_region(s, model="partial"))
+        p0 = _timed(lambda: partial_region(s, target_at=q0), "partial at g", out, {})
+        incl(rp, p0, "recognizable partial ⊆ partial at G")
+    if swept:
+        p_in = run(
+            "partial in",
+            lambda: partial_region(s, target_in="goal", theta=theta, conservative=True),
+        )
+        for v in verts[:4]:
+            pv = _timed(
+                lambda v=v: partial_region(s, target_at=(v[0], v[1], theta)),
+                "partial at v",
+                out,
+                {},
+            )
+            incl(p_in, pv, "translating ⊆ stationary (partial)")
+        if poly_gh:
+            run(
+                "recognizable partial 5.2",
+                lambda: recognizable_region(s, model="partial", theta=theta, conservative=True),
+            )
+    if translate:
+        k = int(rng.integers(1, 6))
+        unit = math.ldexp(1.0, math.ceil(math.log2(D)))
+        o = float(10**k) * unit
+        try:
+            t = Scene.from_dict(_translated(d, o))
+        except SceneError as e:
+            out.append(Finding("translation", "validation", f"offset {o:g}: {e}"))
+            return out, times
+        for name, fn in (
+            ("complete at", lambda sc, dx: complete_region(sc, target_at=(q_at[0] + dx, q_at[1] + dx, theta))),  # noqa: E501
+            ("partial at", lambda sc, dx: partial_region(sc, target_at=(q_at[0] + dx, q_at[1] + dx, theta))),  # noqa: E501
+            ("recognizable complete", lambda sc, dx: recognizable_region(sc, theta=theta)),
+        ):  # fmt: skip
+            try:
+                a = fn(s, 0.0)
+                b = shapely.affinity.translate(fn(t, o), -o, -o)
+            except (SceneError, NotImplementedError):
+                continue
+            except Exception as e:  # noqa: BLE001
+                out.append(Finding("crash", name + " (translated)", f"{type(e).__name__}: {e}"))
+                continue
+            diff = shapely.symmetric_difference(a, b).area
+            if diff > 1e-9 * D * D:
+                out.append(Finding("translation", name, f"offset {o:g}: {diff / D**2:.3g} D^2"))
+    return out, times
+
+
+# ---------------------------------------------------------------------------------------------
+# command line
+# ---------------------------------------------------------------------------------------------
+
+
+def run_many(
+    n: int, *, seed: int = 0, swept: bool = False, max_edges: int = 60, verbose: bool = False
+) -> dict[str, Any]:
+    """Fuzz ``n`` scenes (seeds ``seed .. seed + n - 1``); returns a summary dictionary."""
+    kinds: Counter[str] = Counter()
+    failing: list[dict[str, Any]] = []
+    slowest: dict[str, float] = {}
+    n_valid = 0
+    t0 = time.perf_counter()
+    for i in range(seed, seed + n):
+        d = fuzz_scene(i, max_edges=max_edges)
+        if d is None:
+            continue
+        n_valid += 1
+        found, times = check_scene(d, swept=swept, seed=i)
+        for k, v in times.items():
+            slowest[k] = max(slowest.get(k, 0.0), v)
+        for f in found:
+            kinds[f.kind] += 1
+        if found:
+            failing.append(
+                {"seed": i, "features": d.get("features"), "findings": [vars(f) for f in found]}
+            )
+            if verbose:
+                print(i, d.get("features"), [vars(f) for f in found], file=sys.stderr)
+    return {
+        "scenes": n,
+        "valid": n_valid,
+        "violations": dict(kinds),
+        "failing_scenes": failing,
+        "slowest_query_s": {k: round(v, 3) for k, v in sorted(slowest.items())},
+        "seconds": round(time.perf_counter() - t0, 1),
+    }
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m geometry.fuzz", description=__doc__.split("\n")[0])
+    ap.add_argument("--n", type=int, default=200, help="number of seeds (default 200)")
+    ap.add_argument("--seed", type=int, default=0, help="first seed")
+    ap.add_argument(
+        "--swept", action="store_true", help="also the swept (target_in) partial queries"
+    )
+    ap.add_argument("--max-edges", type=int, default=60)
+    ap.add_argument("--json", help="write the summary (with failing seeds) to this file")
+    ap.add_argument("-v", "--verbose", action="store_true")
+    a = ap.parse_args(argv)
+    res = run_many(a.n, seed=a.seed, swept=a.swept, max_edges=a.max_edges, verbose=a.verbose)
+    if a.json:
+        with open(a.json, "w", encoding="utf-8") as f:
+            json.dump(res, f, indent=1)
+    print(f"seeds {a.seed}..{a.seed + a.n - 1}: {res['valid']} valid scenes, {res['seconds']} s")
+    for k in ("crash", "invalid", "outside", "inclusion", "unsafe", "translation", "hang"):
+        print(f"  {k:12s} {res['violations'].get(k, 0)}")
+    print("  slowest query (s):", res["slowest_query_s"])
+    return 1 if res["violations"] else 0
+
+
+if __name__ == "__main__":  # pragma: no cover
+    raise SystemExit(main())
