@@ -16,7 +16,10 @@ structures already built):
 and, **in the same run on the same scenes**, the anchor: one CGAL visibility polygon
 (pyvispoly's triangular expansion, ``compute_visibility_polygon``) at each of 20 free
 points, median per point.  The table gives each median, its ratio to the anchor, and
-the log-log growth slope (least squares over 100 .. 1,600 edges).  Written to
+the log-log growth slope (least squares over 100 .. 1,600 edges).  Up to ``--brute-max``
+edges (default 1,600) the complete and partial queries are also timed with the grid index
+switched off (the numpy brute-force ray casts, the code path without numba), so the
+speed-up is read off one run.  Written to
 ``benchmarks/results/scaling.md``.  pyvispoly is optional (dev extra); without it the
 anchor columns are empty.  The machine is shared: quote ratios and medians.
 """
@@ -132,7 +135,21 @@ def _fmt_ms(t: float | None) -> str:
     return f"{ms:,.0f}" if ms >= 100 else f"{ms:.1f}" if ms >= 1 else f"{ms:.2f}"
 
 
-def run(edges: tuple[int, ...], reps: int, budget: float, office: bool = True) -> str:
+def _brute(fn: Callable[[], object], reps: int, budget: float) -> float:
+    """:func:`_median_time` with :mod:`geometry.visindex` switched off."""
+    from geometry import visindex
+
+    saved = visindex._HAVE_NUMBA
+    visindex._HAVE_NUMBA = False
+    try:
+        return _median_time(fn, reps, budget)
+    finally:
+        visindex._HAVE_NUMBA = saved
+
+
+def run(
+    edges: tuple[int, ...], reps: int, budget: float, office: bool = True, brute_max: int = 1600
+) -> str:
     rows = []
     cases: list[tuple[str, int, Scene]] = []
     for n in edges:
@@ -152,6 +169,13 @@ def run(edges: tuple[int, ...], reps: int, budget: float, office: bool = True) -
             ratio = f"{t / anchor:,.0f}x" if anchor else "-"
             row.append(f"{_fmt_ms(t)} ({ratio})")
             print(f"  {label:>12} edges={n:5d} {qname:24s} {_fmt_ms(t):>8} ms", flush=True)
+        for qname, fn in QUERIES[:2]:
+            if n <= brute_max:
+                tb = _brute(lambda fn=fn, s=s: fn(s), reps, budget)
+                print(f"  {label:>12} edges={n:5d} {qname:24s} {_fmt_ms(tb):>8} ms (brute)")
+                row.append(_fmt_ms(tb))
+            else:
+                row.append("-")
         rows.append(row)
     slopes = []
     for qname, _ in QUERIES:
@@ -160,6 +184,8 @@ def run(edges: tuple[int, ...], reps: int, budget: float, office: bool = True) -
     head = (
         "| scene | edges | pyvispoly point query, ms | "
         + " | ".join(f"{q}, ms (x anchor)" for q, _ in QUERIES)
+        + " | "
+        + " | ".join(f"{q} without the index, ms" for q, _ in QUERIES[:2])
         + " |"
     )
     lines = [
@@ -168,9 +194,9 @@ def run(edges: tuple[int, ...], reps: int, budget: float, office: bool = True) -
         "CGAL visibility polygon (pyvispoly) at 20 free points of the same scene, same run.",
         "",
         head,
-        "|" + " --- |" * (3 + len(QUERIES)),
+        "|" + " --- |" * (5 + len(QUERIES)),
         *("| " + " | ".join(r) + " |" for r in rows),
-        "| growth slope 100 -> 1,600 | | | " + " | ".join(slopes) + " |",
+        "| growth slope 100 -> 1,600 | | | " + " | ".join(slopes) + " | | |",
     ]
     return "\n".join(lines) + "\n"
 
@@ -183,10 +209,13 @@ def main(argv: list[str] | None = None) -> None:
         "--budget", type=float, default=20.0, help="seconds per query and scene (fewer reps)"
     )
     ap.add_argument("--no-office", action="store_true", help="skip the bundled office floor")
+    ap.add_argument(
+        "--brute-max", type=int, default=1600, help="largest scene also timed without the index"
+    )
     ap.add_argument("--out", type=Path, default=RESULTS)
     args = ap.parse_args(argv)
     edges = tuple(n for n in EDGES if n <= args.max_edges)
-    table = run(edges, args.reps, args.budget, office=not args.no_office)
+    table = run(edges, args.reps, args.budget, office=not args.no_office, brute_max=args.brute_max)
     print(table)
     args.out.parent.mkdir(parents=True, exist_ok=True)
     cmd = "python -m benchmarks.scaling" + (
