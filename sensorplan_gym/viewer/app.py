@@ -167,7 +167,15 @@ class ViewerApp:
             line_width=1,
             name="probe:vis",
         )
-        self.probe_src = ColumnDataSource({"x": [], "y": [], "ax": [], "ay": []}, name="src:probe")
+        self.probe_src = ColumnDataSource(
+            {"x": [], "y": [], "ax": [], "ay": [], "r": [], "a0": [], "a1": []}, name="src:probe"
+        )
+        # the field of view at the best aim (drawn only when it is narrower than 360 degrees)
+        fig.wedge(
+            "x", "y", radius="r", start_angle="a0", end_angle="a1", source=self.probe_src,
+            fill_color="#7b3294", fill_alpha=0.12, line_color="#7b3294", line_alpha=0.5,
+            name="probe:fov",
+        )  # fmt: skip
         fig.segment(
             "x",
             "y",
@@ -432,12 +440,26 @@ class ViewerApp:
         res = probe(self.layers, x, y)
         xs, ys = geom_to_multipolygon(res["vis"])
         self.vis_src.data = {"xs": [xs] if xs else [], "ys": [ys] if ys else []}
+        fov = self.settings.fov
         if res["free"] and res["aim"] is not None:
+            psi = res["aim"]
             L = 0.05 * self.scene.diameter
-            ax, ay = x + L * math.cos(res["aim"]), y + L * math.sin(res["aim"])
-            self.probe_src.data = {"x": [x], "y": [y], "ax": [ax], "ay": [ay]}
+            ax, ay = x + L * math.cos(psi), y + L * math.sin(psi)
+            r = 0.25 * self.scene.diameter if fov < 2 * math.pi - 1e-9 else 0.0
+            self.probe_src.data = {
+                "x": [x], "y": [y], "ax": [ax], "ay": [ay], "r": [r],
+                "a0": [psi - fov / 2], "a1": [psi + fov / 2],
+            }  # fmt: skip
         else:
-            self.probe_src.data = {"x": [x], "y": [y], "ax": [x], "ay": [y]}
+            self.probe_src.data = {
+                "x": [x],
+                "y": [y],
+                "ax": [x],
+                "ay": [y],
+                "r": [0.0],
+                "a0": [0.0],
+                "a1": [0.0],
+            }
 
         def yn(v):
             return (
