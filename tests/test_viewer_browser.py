@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import shutil
 import socket
 import subprocess
@@ -89,13 +90,37 @@ def test_export_is_self_contained(export_file):
     text = export_file.read_text(encoding="utf-8")
     # BokehJS inlined, nothing fetched from a CDN or a server
     assert "cdn.bokeh.org" not in text
-    assert "<script src=" not in text.replace(" ", "").lower().replace(
-        "<scriptsrc=", "<script src="
-    )
-    # the document JSON carries the five layers with data
+    assert not re.search(r"<script[^>]*\bsrc=", text, flags=re.I)
+    assert not re.search(r"<link[^>]*\bhref=", text, flags=re.I)
+    # the document JSON carries the five layers, each with its exact region's vertices
+    m = re.search(r'<script type="application/json" id="[^"]+">\s*(.*?)\s*</script>', text, re.S)
+    assert m, "no Bokeh document JSON in the page"
+    sources: dict[str, dict] = {}
+
+    def walk(o):
+        if isinstance(o, dict):
+            if o.get("name") == "ColumnDataSource":
+                sources[o["attributes"].get("name")] = dict(o["attributes"]["data"]["entries"])
+            for v in o.values():
+                walk(v)
+        elif isinstance(o, list):
+            for v in o:
+                walk(v)
+
+    walk(json.loads(m.group(1)))
+    from geometry import recognizable_region
+    from sensorplan_gym.core.world import load_scene
+
     for key in LAYER_KEYS:
         assert f'"layer:{key}"' in text
-        assert f'"src:{key}"' in text
+        data = sources[f"src:{key}"]
+        assert len(data["xs"]) == 1 and len(data["xs"][0]) >= 1  # one row of polygons
+    area = sources["src:recognizable"]["area"][0]
+    assert area == pytest.approx(recognizable_region(load_scene("lab")).area, rel=1e-12)
+    ring = np.column_stack(
+        [sources["src:recognizable"]["xs"][0][0][0], sources["src:recognizable"]["ys"][0][0][0]]
+    )
+    assert ring.shape[0] >= 3
 
 
 def test_export_renders_in_chromium(export_file, tmp_path):
@@ -111,14 +136,11 @@ def test_export_renders_in_chromium(export_file, tmp_path):
     img = _png(shot)
     # not blank: many colours, and the regions drawn in their colours
     assert len(np.unique(img.reshape(-1, 3), axis=0)) > 200
-    from sensorplan_gym.viewer.figure import ALPHAS, COLORS
-
     assert _has_colour(img, "#454545", 1.0, tol=6) > 5000  # obstacles
     # the recognizable region lies over the other layers: look for its green hue
     g = img.astype(int)
     green = (g[..., 1] - np.maximum(g[..., 0], g[..., 2]) > 40).sum()
     assert green > 5000, green
-    assert COLORS and ALPHAS  # the palette the page is drawn with
     # the DOM: the Bokeh root element and the layer checkboxes were rendered by BokehJS
     dom = _chromium(tmp_path, "--virtual-time-budget=10000", "--dump-dom", export_file.as_uri())
     assert "data-root-id" in dom.stdout
