@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .kernels import point_sweep
 from .segments import Segments
 
 __all__ = ["sweep", "sweep_batch"]
@@ -20,28 +21,18 @@ def sweep_batch(px, py, dx, dy, S, radius: float, skin) -> np.ndarray:
     touching a segment cannot move further into it."""
     px, py, dx, dy = (np.asarray(v, dtype=np.float64) for v in (px, py, dx, dy))
     n = px.shape[0]
-    skin = np.broadcast_to(np.asarray(skin, dtype=np.float64), (n,))
+    skin = np.asarray(skin, dtype=np.float64)
+    if skin.ndim == 0:
+        skin = np.full(n, float(skin))
     out = np.ones(n)
     if S.x0.shape[-1] == 0 or n == 0:
         return out
     moving = (dx != 0.0) | (dy != 0.0)
     d_x, d_y = dx[:, None], dy[:, None]
     if radius == 0.0:  # a point: one ray p + t d, t in [0, 1], against every segment
-        ax = S.x0 - px[:, None]
-        ay = S.y0 - py[:, None]
-        with np.errstate(**_ERR):
-            inv = 1.0 / (d_x * S.ey - d_y * S.ex)
-            t = (ax * S.ey - ay * S.ex) * inv
-            u = (ax * d_y - ay * d_x) * inv
-        t[~((t >= 0.0) & (u >= 0.0) & (u <= 1.0) & np.isfinite(inv))] = np.inf
-        i = t.argmin(axis=1)
-        ti = t[np.arange(n), i]
-        nx = np.broadcast_to(S.nx, t.shape)[np.arange(n), i]
-        ny = np.broadcast_to(S.ny, t.shape)[np.arange(n), i]
-        rate = np.maximum(np.abs(nx * dx + ny * dy), 1e-300)  # approach speed
-        hit = (ti <= 1.0) & moving
-        out[hit] = np.maximum(0.0, ti[hit] - skin[hit] / rate[hit])
-        return out
+        seg = [a if a.ndim == 2 else a[None, :] for a in (S.x0, S.y0, S.ex, S.ey, S.nx, S.ny)]
+        t = point_sweep(px, py, dx, dy, *seg, np.ascontiguousarray(skin))
+        return np.where(moving, t, 1.0)
     ax = px[:, None] - S.x0
     ay = py[:, None] - S.y0
     L2 = S.ex * S.ex + S.ey * S.ey

@@ -83,24 +83,26 @@ class RobotVectorObs:
         self.space = spaces.Box(low, high, dtype=np.float32)
 
     def __call__(self, sim: BatchSim, idx: np.ndarray) -> np.ndarray:
-        x, y, psi = sim.x[idx], sim.y[idx], sim.psi[idx]
+        sel = sim.sel(idx)
+        x, y, psi = sim.x[sel], sim.y[sel], sim.psi[sel]
+        K = sim.obs_consts[sel]  # lo, 2 / span, 1 / diameter, 1 / reach, G, H centres
         c, s = np.cos(psi), np.sin(psi)
-        lo, hi = sim.lo[idx], sim.hi[idx]
-        inv = 1.0 / sim.diameter[idx]
-        out = np.empty((len(idx), 8 + 3 * self.n))
-        out[:, 0] = 2 * (x - lo[:, 0]) / (hi[:, 0] - lo[:, 0]) - 1.0
-        out[:, 1] = 2 * (y - lo[:, 1]) / (hi[:, 1] - lo[:, 1]) - 1.0
-        np.clip(out[:, :2], -1.0, 1.0, out=out[:, :2])
-        out[:, 2], out[:, 3] = c, s
-        for k, ctr in ((4, sim.goal_c[idx]), (6, sim.fail_c[idx])):
-            gx, gy = ctr[:, 0] - x, ctr[:, 1] - y
-            out[:, k] = (c * gx + s * gy) * inv
-            out[:, k + 1] = (-s * gx + c * gy) * inv
         n = self.n
-        out[:, 8 : 8 + n] = sim.scan_dist[idx] / sim.reach[idx, None]
-        nrm = sim.scan_normal[idx]  # robot-frame x's, then y's
-        out[:, 8 + n : 8 + 2 * n] = c[:, None] * nrm[..., 0] + s[:, None] * nrm[..., 1]
-        out[:, 8 + 2 * n :] = -s[:, None] * nrm[..., 0] + c[:, None] * nrm[..., 1]
+        out = np.empty((len(x), 8 + 3 * n))
+        out[:, 0] = (x - K[:, 0]) * K[:, 2] - 1.0
+        out[:, 1] = (y - K[:, 1]) * K[:, 3] - 1.0
+        np.clip(out[:, :2], -1.0, 1.0, out=out[:, :2])
+        out[:, 2] = c
+        out[:, 3] = s
+        c1, s1 = c[:, None], s[:, None]
+        gx = K[:, 6::2] - x[:, None]  # to G and to H, world frame
+        gy = K[:, 7::2] - y[:, None]
+        out[:, 4:8:2] = (c1 * gx + s1 * gy) * K[:, 4:5]  # robot frame / diameter
+        out[:, 5:8:2] = (c1 * gy - s1 * gx) * K[:, 4:5]
+        out[:, 8 : 8 + n] = sim.scan_dist[sel] * K[:, 5:6]
+        nrm = sim.scan_normal[sel]  # robot-frame x's, then y's
+        out[:, 8 + n : 8 + 2 * n] = c1 * nrm[..., 0] + s1 * nrm[..., 1]
+        out[:, 8 + 2 * n :] = c1 * nrm[..., 1] - s1 * nrm[..., 0]
         # every entry is within its bounds up to rounding of order 1e-16, which the float32
         # conversion absorbs (values within 2**-25 of +-1 round to +-1)
         return out.astype(np.float32)

@@ -148,16 +148,12 @@ class SegmentRows:
 
 def point_segment_distance(px: np.ndarray, py: np.ndarray, S) -> np.ndarray:
     """Distance ``(N,)`` from points ``(px[i], py[i])`` to the nearest segment of ``S`` (a
-    :class:`Segments` shared by all points, or ``(N, M)`` rows, one set per point)."""
-    ax = px[:, None] - S.x0
-    ay = py[:, None] - S.y0
-    L2 = S.ex * S.ex + S.ey * S.ey
-    with np.errstate(divide="ignore", invalid="ignore"):
-        t = np.where(L2 > 0, (ax * S.ex + ay * S.ey) / L2, 0.0)
-    np.clip(t, 0.0, 1.0, out=t)
-    qx = ax - t * S.ex
-    qy = ay - t * S.ey
-    return np.sqrt(np.min(qx * qx + qy * qy, axis=1))
+    :class:`Segments` shared by all points, or ``(N, M)`` rows, one set per point); ``inf``
+    when there are none."""
+    from .kernels import seg_distance
+
+    rows = [a if a.ndim == 2 else a[None, :] for a in (S.x0, S.y0, S.ex, S.ey)]
+    return seg_distance(np.asarray(px, dtype=np.float64), np.asarray(py, dtype=np.float64), *rows)
 
 
 __all__ += ["point_segment_distance"]

@@ -12,8 +12,9 @@ Optional Gaussian noise (standard deviation ``noise``, scene units) is added to
 the hit distances, which are then clipped to ``[0, max_range]``; normals are
 noise-free.
 
-:func:`cast_batch` is the one implementation: N sensors x B beams x M segments in one
-broadcast (about 15 numpy operations on ``(N, B, M)`` arrays, no Python loop); the
+:func:`cast_batch` is the one implementation: N sensors x B beams x M segments, the inner
+loop in :func:`.kernels.cast` (compiled with numba when the ``fast`` extra is
+installed, else one numpy broadcast over ``(N, B, M)``; the answers are identical); the
 one-sensor helpers :func:`cast_rays` and :meth:`RangeSensor.read` call it with N = 1.
 """
 
@@ -23,16 +24,12 @@ import math
 
 import numpy as np
 
+from .kernels import cast
 from .segments import Segments
 
 __all__ = ["RangeSensor", "Segments", "cast_batch", "cast_rays"]
 
 _ERR = {"divide": "ignore", "invalid": "ignore", "over": "ignore"}
-
-
-def _seg3(a: np.ndarray) -> np.ndarray:
-    """``(M,)`` -> ``(1, 1, M)``; ``(N, M)`` -> ``(N, 1, M)`` (broadcast against beams)."""
-    return a[None, None, :] if a.ndim == 1 else a[:, None, :]
 
 
 def cast_batch(
@@ -51,55 +48,27 @@ def cast_batch(
     ox = np.asarray(ox, dtype=np.float64)
     oy = np.asarray(oy, dtype=np.float64)
     n, b = ang.shape
-    mr = np.broadcast_to(np.asarray(max_range, dtype=np.float64), (n,))
+    mr = np.asarray(max_range, dtype=np.float64)
+    if mr.ndim == 0:
+        mr = np.full(n, float(mr))
     if S.x0.shape[-1] == 0:
         return np.repeat(mr[:, None], b, 1), np.zeros((n, b, 2)), np.zeros((n, b), bool)
-    dx = np.cos(ang)[:, :, None]
-    dy = np.sin(ang)[:, :, None]
-    ax = S.x0 - ox[:, None]  # (N, M): a - o
-    ay = S.y0 - oy[:, None]
-    ex, ey = _seg3(S.ex), _seg3(S.ey)
-    tnum = (ax * S.ey - ay * S.ex)[:, None, :]  # cross(a - o, e)
-    ax3, ay3 = ax[:, None, :], ay[:, None, :]
-    with np.errstate(**_ERR):
-        inv = 1.0 / (dx * ey - dy * ex)  # 1 / cross(d, e)
-        t = tnum * inv
-        u = (ax3 * dy - ay3 * dx) * inv  # cross(a - o, d) / cross(d, e)
-    w = np.minimum(u, 1.0 - u)
-    np.minimum(w, t, out=w)
-    t[~(w >= 0.0)] = np.inf  # also NaN (parallel, collinear or padding segments)
-    idx = t.argmin(axis=2)  # (N, B)
-    r = _rows(n)
-    dist = t[r, _cols(b), idx]
-    hit = dist <= mr[:, None]
-    np.minimum(dist, mr[:, None], out=dist)
-    # normal at the hit segment, turned to face the origin
-    if S.nx.ndim == 1:
-        nx, ny = S.nx[idx], S.ny[idx]
-    else:
-        nx, ny = S.nx[r, idx], S.ny[r, idx]
-    side = -(nx * ax[r, idx] + ny * ay[r, idx])
-    sgn = np.sign(side) * hit
-    return dist, np.stack([nx * sgn, ny * sgn], axis=2), hit
+    dist, hit, gx, gy = cast(
+        ox,
+        oy,
+        np.cos(ang),
+        np.sin(ang),
+        *(_2d(v) for v in (S.x0, S.y0, S.ex, S.ey, S.nx, S.ny)),
+        mr,
+    )
+    nrm = np.empty((n, b, 2))
+    nrm[:, :, 0] = gx
+    nrm[:, :, 1] = gy
+    return dist, nrm, hit
 
 
-_ROWS: dict[int, np.ndarray] = {}
-_COLS: dict[int, np.ndarray] = {}
-
-
-def _rows(n: int) -> np.ndarray:
-    """``arange(n)[:, None]`` (cached)."""
-    r = _ROWS.get(n)
-    if r is None:
-        r = _ROWS[n] = np.arange(n)[:, None]
-    return r
-
-
-def _cols(b: int) -> np.ndarray:
-    c = _COLS.get(b)
-    if c is None:
-        c = _COLS[b] = np.arange(b)[None, :]
-    return c
+def _2d(a: np.ndarray) -> np.ndarray:
+    return a if a.ndim == 2 else a[None, :]
 
 
 def cast_rays(

@@ -391,16 +391,19 @@ def _anchor(g: shapely.Geometry) -> tuple[float, float]:
     return (float(c.x), float(c.y))
 
 
-def field_lookup(F: np.ndarray, ox, oy, inv_h, x: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """Values of clearance fields at points: ``F`` ``(k, k)`` for all points or ``(N, k, k)``
-    one per point, origins/scales scalars or ``(N,)``; 0 outside the field."""
+def field_lookup(
+    F: np.ndarray, ox, oy, inv_h, x: np.ndarray, y: np.ndarray, rows: np.ndarray | None = None
+) -> np.ndarray:
+    """Values of clearance fields at points ``(x, y)``: ``F`` ``(k, k)`` for all points, or
+    ``(N, k, k)`` with point ``p`` read from field ``rows[p]``; origins ``ox, oy`` and scales
+    ``inv_h`` scalars or per point; 0 outside the field."""
     fi = (x - ox) * inv_h
     fj = (y - oy) * inv_h
     k = F.shape[-1]
     inside = (fi >= 0) & (fj >= 0) & (fi < k) & (fj < k)
     i = np.where(inside, fi, 0).astype(np.intp)
     j = np.where(inside, fj, 0).astype(np.intp)
-    v = F[i, j] if F.ndim == 2 else F[np.arange(len(x)), i, j]
+    v = F[i, j] if F.ndim == 2 else F[rows, i, j]
     return np.where(inside, v, 0.0)
 
 
