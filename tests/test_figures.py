@@ -141,3 +141,21 @@ def test_env_legend_matches_renderer_colours():
     assert to_hex(region.get_facecolor()) == "#7fd37f"
     for need in ("obstacles", "G: goal region", "H: failure region", "range beams"):
         assert need in labels
+
+
+def test_human_viewer_says_when_it_cannot_show():
+    import warnings
+
+    import matplotlib.pyplot as plt
+
+    from sensorplan_gym.core.rendering import HumanViewer
+
+    v = HumanViewer()
+    frame = np.zeros((8, 8, 3), np.uint8)
+    with pytest.warns(UserWarning, match="cannot open a window"):
+        v.show(frame, 10)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        v.show(frame, 10)  # once per viewer
+    v.close()
+    plt.close("all")

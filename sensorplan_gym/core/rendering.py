@@ -8,7 +8,8 @@ with a heading tick), its field-of-view wedge and its beams (thin lines to the
 hit points).
 
 ``human`` mode shows the same frame with pyplot; under a non-interactive
-backend (Agg, e.g. on CI) it only draws, it opens no window and does not fail.
+backend (Agg, e.g. on CI or without a display) it only draws, it opens no window and
+does not fail, and it says so once with a ``UserWarning`` naming the backend.
 """
 
 from __future__ import annotations
@@ -227,14 +228,16 @@ class Renderer:
 
 
 class HumanViewer:
-    """Shows frames with pyplot; a no-op display under a non-interactive backend."""
+    """Shows frames with pyplot; a no-op display under a non-interactive backend (warned
+    once per viewer)."""
 
     def __init__(self) -> None:
         self._plt = None
         self._im = None
+        self._warned = False
 
     def __getstate__(self) -> dict:
-        return {"_plt": None, "_im": None}
+        return {"_plt": None, "_im": None, "_warned": False}
 
     def show(self, frame: np.ndarray, fps: float) -> None:
         import matplotlib
@@ -252,6 +255,18 @@ class HumanViewer:
         backend = matplotlib.get_backend().lower()
         if "agg" in backend or backend in ("pdf", "ps", "svg", "cairo", "template"):
             self._im.figure.canvas.draw()  # non-interactive: draw only, no window
+            if not getattr(self, "_warned", False):
+                import warnings
+
+                warnings.warn(
+                    f"render_mode='human': matplotlib's backend {backend!r} cannot open a "
+                    "window (no display, or MPLBACKEND=Agg), so nothing is shown; use "
+                    "render_mode='rgb_array' to get the frames, or an interactive backend "
+                    "(e.g. MPLBACKEND=TkAgg) on a machine with a display",
+                    UserWarning,
+                    stacklevel=3,
+                )
+                self._warned = True
             return
         self._plt.pause(1.0 / fps)
 
