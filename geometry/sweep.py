@@ -51,6 +51,7 @@ import numpy as np
 import shapely
 from shapely import affinity
 
+from . import visindex as _visindex
 from ._common import polygonal
 from ._vis import TAU, Domain, RayEscapeError, gaps_many
 
@@ -285,6 +286,8 @@ class Sweeper:
         own = np.repeat(np.arange(len(p)), np.diff(off))
         ok = g.seg >= 0
         g_lo, g_hi, own, seg = g.lo[ok], g.hi[ok], own[ok], g.seg[ok]
+        if _visindex.available():  # the compiled twin of the clipping below
+            return _visindex.window_ranges(g_lo, g_hi, own, seg, self.env.seg, p, base, self.hull)
         sg = self.env.seg[seg]
         s0, sd = sg[:, :2], sg[:, 2:] - sg[:, :2]
         pp = p[own]

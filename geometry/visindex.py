@@ -456,3 +456,81 @@ def sorted_gaps(
     _gaps_kernel(q, start, width, vert, crit, tol, interior, False, off, lo, hi)
     owner = np.repeat(np.arange(n), np.diff(off))
     return owner, lo, hi
+
+
+@_njit
+def _windows_kernel(
+    g_lo, g_hi, own, seg_idx, seg, p, base, kv, shift, out_lo, out_hi, out_own
+):  # pragma: no cover
+    TWO_PI = 2.0 * math.pi
+    k = kv.shape[0]
+    m = 0
+    for i in range(g_lo.shape[0]):
+        j = seg_idx[i]
+        o = own[i]
+        s0x, s0y = seg[j, 0], seg[j, 1]
+        sdx, sdy = seg[j, 2] - s0x, seg[j, 3] - s0y
+        px, py = p[o, 0], p[o, 1]
+        cp = sdx * (py - s0y) - sdy * (px - s0x)
+        side_p = 1.0 if cp > 0 else (-1.0 if cp < 0 else 0.0)
+        b = base[o]
+        amin = math.inf
+        amax = -math.inf
+        for a in range(k):
+            sa = (sdx * (kv[a, 1] - s0y) - sdy * (kv[a, 0] - s0x)) * side_p
+            if sa > 0:
+                r = (math.atan2(kv[a, 1] - py, kv[a, 0] - px) - b + math.pi) % TWO_PI - math.pi
+                amin = min(amin, r)
+                amax = max(amax, r)
+        for a in range(k):
+            c = (a + 1) % k
+            sa = (sdx * (kv[a, 1] - s0y) - sdy * (kv[a, 0] - s0x)) * side_p
+            sc = (sdx * (kv[c, 1] - s0y) - sdy * (kv[c, 0] - s0x)) * side_p
+            if (sa > 0) != (sc > 0):
+                lam = sa / (sa - sc)
+                xx = kv[a, 0] + lam * (kv[c, 0] - kv[a, 0])
+                xy = kv[a, 1] + lam * (kv[c, 1] - kv[a, 1])
+                r = (math.atan2(xy - py, xx - px) - b + math.pi) % TWO_PI - math.pi
+                amin = min(amin, r)
+                amax = max(amax, r)
+        r_lo = (g_lo[i] - b + math.pi) % TWO_PI - math.pi
+        r_hi = r_lo + (g_hi[i] - g_lo[i])
+        lo = max(r_lo + shift, amin)
+        hi = min(r_hi + shift, amax)
+        if hi > lo:
+            out_lo[m] = lo
+            out_hi[m] = hi
+            out_own[m] = o
+            m += 1
+    return m
+
+
+def window_ranges(
+    g_lo: np.ndarray,
+    g_hi: np.ndarray,
+    own: np.ndarray,
+    seg_idx: np.ndarray,
+    seg: np.ndarray,
+    p: np.ndarray,
+    base: np.ndarray,
+    hull: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Compiled twin of the gap-clipping step of :meth:`geometry.sweep.Sweeper._windows`:
+    for every gap ``(g_lo, g_hi)`` of probe ``p[own]`` that ends on segment ``seg_idx``,
+    the directions (relative to ``base[own]``, radians) of the part of the convex hull
+    ``hull`` in front of that segment, intersected with the gap (once as is, once
+    shifted by -2 pi).  Returns ``lo, hi, own`` in the order of the numpy code."""
+    args = [np.ascontiguousarray(a, dtype=np.float64) for a in (g_lo, g_hi)] + [
+        np.ascontiguousarray(own, dtype=np.int64),
+        np.ascontiguousarray(seg_idx, dtype=np.int64),
+    ]
+    rest = [np.ascontiguousarray(a, dtype=np.float64) for a in (seg, p, base, hull)]
+    los, his, owns = [], [], []
+    for shift in (0.0, -2.0 * math.pi):
+        n = len(g_lo)
+        lo, hi, ow = np.empty(n), np.empty(n), np.empty(n, dtype=np.int64)
+        m = _windows_kernel(*args, *rest, shift, lo, hi, ow)
+        los.append(lo[:m])
+        his.append(hi[:m])
+        owns.append(ow[:m])
+    return np.concatenate(los), np.concatenate(his), np.concatenate(owns)

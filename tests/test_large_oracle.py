@@ -196,3 +196,51 @@ def test_compiled_sorted_gaps_equal_numpy():
         assert len(a[0]) > 10 * n
         for x, y in zip(a, b, strict=True):
             assert np.array_equal(x, y)
+
+
+@pytest.mark.skipif(not visindex.available(), reason="numba not installed (fast extra)")
+def test_compiled_sweep_windows_equal_numpy(monkeypatch):
+    """The swept point test's window clipping (visindex.window_ranges) returns exactly what
+    the numpy code of Sweeper._windows returns, on the probes of a real swept query."""
+    from geometry import sweep
+
+    d = scene_with_edges(60, 1)
+    g = shapely.Polygon(d["goal"])
+    c = g.representative_point()
+    r = 0.8 * g.exterior.distance(c)
+    ang = 0.3 + 2 * np.pi * np.arange(5) / 5
+    d["goal"] = np.column_stack([c.x + r * np.cos(ang), c.y + r * np.sin(ang)]).tolist()
+    scene = Scene.from_dict(d)
+    calls = []
+    orig = sweep.Sweeper._windows
+
+    def spy(self, p, base, sectors):
+        if len(calls) < 40:
+            calls.append((self, p.copy(), base.copy(), sectors.copy()))
+        return orig(self, p, base, sectors)
+
+    monkeypatch.setattr(sweep.Sweeper, "_windows", spy)
+    partial_region(scene, target_in="goal", theta=0.3)
+    assert len(calls) >= 3
+    # the probes of a sweep sit inside shadows and mostly see nothing of K: add free
+    # points looking at K over the whole circle, which do see into it
+    sw = calls[0][0]
+    fs = sw.free  # the sweeper's frame (the queries may work in a local frame)
+    shapely.prepare(fs)
+    rng = np.random.default_rng(0)
+    x0, y0, x1, y1 = fs.bounds
+    pts = rng.uniform([x0, y0], [x1, y1], (400, 2))
+    pts = pts[shapely.contains_xy(fs, pts[:, 0], pts[:, 1])]
+    base = np.arctan2(*(sw.hull.mean(axis=0) - pts).T[::-1])
+    full = np.stack([base - np.pi, np.full(len(pts), 2 * np.pi)], axis=1)
+    calls.append((sw, pts, base, full))
+    n_ranges = 0
+    for sw, p, base, sectors in calls:
+        fast = orig(sw, p, base, sectors)
+        monkeypatch.setattr(visindex, "_HAVE_NUMBA", False)
+        slow = orig(sw, p, base, sectors)
+        monkeypatch.setattr(visindex, "_HAVE_NUMBA", True)
+        for x, y in zip(fast, slow, strict=True):
+            assert np.array_equal(x, y)
+        n_ranges += len(fast[0])
+    assert n_ranges > 50
