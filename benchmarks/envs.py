@@ -1,27 +1,35 @@
-"""Environment speed: steps/s with random actions and reset times.
+"""Environment speed against CartPole-v1 measured in the same run.
 
-    python -m benchmarks.envs [--steps 4000] [--quick]
+    python -m benchmarks.envs [--quick] [--train]
 
-Prints a markdown table and writes it to ``benchmarks/results/envs.md``.
+Writes a markdown table to ``benchmarks/results/envs.md`` (and prints it).
 
-* steps/s, single env: ``gym.make(id)`` (with its standard wrappers), random actions from
-  ``action_space.sample()`` drawn up front, resets included when an episode ends; the best
-  of three equal chunks (the 2-core machine is often shared, which only ever slows a run).  For
-  Recognize-v0 the decide component is set to 0 ("continue") so episodes are not cut to
-  a step or two by random declarations (the declaring variant is also shown).
-* steps/s, ``make_vec`` with 4 envs: env-steps per second (4 per vector step), sync and
-  async (one worker process per env).
-* reset: median wall time of ``env.reset()`` on a bundled scene (``lab``; the world is
-  cached, so this is the per-episode cost) and on ``scene="random"`` (a new procedural
-  scene, its exact recognizable region and derived data on every reset), for the
-  complete and the partial model.
+* **single env**: ``gym.make(id)`` with its standard wrappers, random actions drawn up front,
+  resets included when an episode ends; CartPole-v1 the same way.
+* **batched**: ``gym.make_vec(id, num_envs=256, vectorization_mode="vector_entry_point")``,
+  env-steps per second (256 per vector step; NEXT_STEP autoresets included); CartPole-v1's
+  own ``CartPoleVectorEnv`` with 256 envs the same way.
+* For Recognize-v0 the decide component is set to 0 ("continue") so that episodes are not
+  cut to a step or two by random declarations; the declaring variant is shown too.
+* **numpy**: the batched core with ``SENSORPLAN_NO_NUMBA=1`` (the numpy fallback of the
+  compiled inner loops, in a subprocess).
+* ``--train``: ``sensorplan train`` PPO on Navigate-v0 with the shipped config
+  (``agents/configs/ppo.yaml``, same hyperparameters) on the batched path and on SB3's
+  DummyVecEnv of single envs; env steps per second of wall clock, updates included.
+
+Every figure is the median of ``--repeats`` timed chunks; ratios are to CartPole-v1 single
+env measured in the same run (the 2-core machine is shared and noisy: compare ratios).
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import platform
+import subprocess
+import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -31,123 +39,154 @@ import numpy as np
 import sensorplan_gym  # noqa: F401
 
 IDS = ["sensorplan/Placement-v0", "sensorplan/Navigate-v0", "sensorplan/Recognize-v0"]
+N_BATCH = 256
 
 
-def _actions(space, n, seed, declare=True):
-    space.seed(seed)
-    acts = [space.sample() for _ in range(n)]
-    if not declare and space.shape == (4,):
-        for a in acts:
-            a[3] = 0.0
-    return acts
+def _no_declare(a: np.ndarray) -> np.ndarray:
+    if a.shape[-1] == 4:
+        a[..., 3] = 0.0
+    return a
 
 
-def steps_per_second(env_id, n, declare=False, **kw):
+def single_sps(env_id: str, steps: int, repeats: int, declare: bool = False, **kw) -> float:
+    """Median steps/s of one env (resets included)."""
     env = gym.make(env_id, **kw)
-    if not isinstance(env.action_space, gym.spaces.Box):
-        declare = True
     env.reset(seed=0)
-    acts = _actions(env.action_space, n, 0, declare)
-    for a in acts[:50]:  # warm-up
-        if any(env.step(a)[2:4]):
-            env.reset()
-    best = 0.0
-    for chunk in np.array_split(np.arange(n), 3):  # best of 3 (the machine may be shared)
+    env.action_space.seed(0)
+    acts = [env.action_space.sample() for _ in range(steps)]
+    if not declare and isinstance(env.action_space, gym.spaces.Box):
+        acts = [_no_declare(a) for a in acts]
+    rates = []
+    for chunk in np.array_split(np.arange(steps), repeats):
         t = time.perf_counter()
         for k in chunk:
             _, _, te, tr, _ = env.step(acts[k])
             if te or tr:
                 env.reset()
-        best = max(best, len(chunk) / (time.perf_counter() - t))
+        rates.append(len(chunk) / (time.perf_counter() - t))
     env.close()
-    return best
+    return float(np.median(rates))
 
 
-def vec_steps_per_second(env_id, n, mode, num_envs=4, **kw):
-    envs = gym.make_vec(env_id, num_envs=num_envs, vectorization_mode=mode, vector_kwargs={}, **kw)
-    try:
-        envs.reset(seed=0)
-        acts = _actions(envs.action_space, n, 0)
-        if envs.single_action_space.shape == (4,):
-            for a in acts:
-                a[:, 3] = 0.0
-        for a in acts[:20]:
-            envs.step(a)
+def batched_sps(
+    env_id: str, vsteps: int, repeats: int, num_envs: int = N_BATCH, declare=False, **kw
+) -> float:
+    """Median env-steps/s of the native vector env (``vector_entry_point``)."""
+    venv = gym.make_vec(env_id, num_envs=num_envs, vectorization_mode="vector_entry_point", **kw)
+    venv.reset(seed=0)
+    venv.action_space.seed(0)
+    acts = [venv.action_space.sample() for _ in range(vsteps)]
+    if not declare and isinstance(venv.single_action_space, gym.spaces.Box):
+        acts = [_no_declare(a) for a in acts]
+    for a in acts[:5]:  # warm-up (compiles, fills caches)
+        venv.step(a)
+    rates = []
+    for chunk in np.array_split(np.arange(vsteps), repeats):
         t = time.perf_counter()
-        for a in acts:
-            envs.step(a)
+        for k in chunk:
+            venv.step(acts[k])
+        rates.append(len(chunk) * num_envs / (time.perf_counter() - t))
+    venv.close()
+    return float(np.median(rates))
+
+
+def numpy_fallback(env_id: str, vsteps: int, repeats: int, **kw) -> float:
+    """:func:`batched_sps` in a subprocess with ``SENSORPLAN_NO_NUMBA=1``."""
+    code = (
+        "import json, benchmarks.envs as b; "
+        f"print(json.dumps(b.batched_sps({env_id!r}, {vsteps}, {repeats}, **{kw!r})))"
+    )
+    env = dict(os.environ, SENSORPLAN_NO_NUMBA="1")
+    out = subprocess.run(
+        [sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True
+    )
+    return float(json.loads(out.stdout.strip().splitlines()[-1]))
+
+
+def train_sps(vec_env: str, timesteps: int) -> float:
+    """Env steps per wall-clock second of ``sensorplan train`` PPO on Navigate-v0."""
+    from agents.train import train
+
+    with tempfile.TemporaryDirectory() as d:
+        t = time.perf_counter()
+        rec = train(
+            "sensorplan/Navigate-v0",
+            "ppo",
+            timesteps=timesteps,
+            seed=0,
+            out=Path(d),
+            vec_env=vec_env,
+            eval_freq=10**9,
+            verbose=0,
+            progress_bar=False,
+            tensorboard=False,
+        )
         dt = time.perf_counter() - t
-    finally:
-        envs.close()
-    return n * num_envs / dt
+    return rec["timesteps"] / dt
 
 
-def reset_ms(env_id, scene, n, **kw):
-    env = gym.make(env_id, scene=scene, **kw)
-    env.reset(seed=987_654)  # seeds not used elsewhere: no cache hits for random scenes
-    ts = []
-    for _ in range(n):
-        t = time.perf_counter()
-        env.reset()
-        ts.append(time.perf_counter() - t)
-    return 1e3 * float(np.median(ts))
-
-
-def main(argv=None):
+def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--steps", type=int, default=4000)
     ap.add_argument("--quick", action="store_true", help="fewer steps (smoke run)")
+    ap.add_argument("--repeats", type=int, default=5)
+    ap.add_argument("--train", action="store_true", help="also time PPO training")
+    ap.add_argument("--train-steps", type=int, default=20_480)
     ap.add_argument("--out", default=str(Path(__file__).parent / "results" / "envs.md"))
     args = ap.parse_args(argv)
-    n = 300 if args.quick else args.steps
-    nv = max(50, n // 8)
-    nr = 8 if args.quick else 40
+    n = 500 if args.quick else 5000
+    nv = 10 if args.quick else 60
+    r = args.repeats
 
+    cart = single_sps("CartPole-v1", 4 * n, r)
+    cart_vec = batched_sps("CartPole-v1", 4 * nv, r)
     rows = []
     for env_id in IDS:
-        for obs in ("vector", "grid"):
-            single = steps_per_second(env_id, n, obs_type=obs)
-            sync = vec_steps_per_second(env_id, nv, "sync", obs_type=obs)
-            asyn = vec_steps_per_second(env_id, nv, "async", obs_type=obs)
-            rows.append((env_id, obs, single, sync, asyn))
-    rec_decl = steps_per_second("sensorplan/Recognize-v0", n, declare=True)
-    cartpole = steps_per_second("CartPole-v1", n)
+        s = single_sps(env_id, n, r)
+        b = batched_sps(env_id, nv, r)
+        g = batched_sps(env_id, max(nv // 4, 3), r, obs_type="grid")
+        npy = numpy_fallback(env_id, max(nv // 4, 3), r)
+        rows.append((env_id, s, b, g, npy))
+    rec_decl = batched_sps("sensorplan/Recognize-v0", nv, r, declare=True)
+    nav_rand = batched_sps("sensorplan/Navigate-v0", nv, r, scene="random")
 
-    resets = []
-    for model, motion in (("complete", "translating"), ("partial", "stationary")):
-        for scene in ("lab", "random"):
-            ms = reset_ms("sensorplan/Navigate-v0", scene, nr, model=model, motion=motion)
-            resets.append((scene, model, motion, ms))
-    ms = reset_ms("sensorplan/Navigate-v0", "random", nr, model="partial", motion="translating")
-    resets.append(("random", "partial", "translating", ms))
+    def ratio(v: float) -> str:
+        return f"{v / cart:.2f}x"
 
     lines = [
         "# Environment speed",
         "",
         f"Machine: {os.cpu_count()} cores, {platform.python_implementation()} "
-        f"{platform.python_version()}, numpy {np.__version__}.  "
-        "Command: `python -m benchmarks.envs`.",
-        f"Load average at the end of the run: {os.getloadavg()[0]:.1f} (other jobs slow every "
-        "row alike; compare with the CartPole-v1 anchor, ~120k steps/s on an idle machine).",
+        f"{platform.python_version()}, numpy {np.__version__}, gymnasium {gym.__version__}.  "
+        f"Command: `python -m benchmarks.envs{' --train' if args.train else ''}`.  "
+        f"Medians of {r} chunks; load average at the end: {os.getloadavg()[0]:.1f}.",
         "",
-        "| env | obs | steps/s (1 env) | env-steps/s (make_vec 4, sync) | "
-        "env-steps/s (make_vec 4, async) |",
-        "| --- | --- | ---: | ---: | ---: |",
+        f"| env (random actions) | single env steps/s | ratio to CartPole | batched x{N_BATCH} "
+        "env-steps/s | ratio | batched grid obs | batched, numpy fallback |",
+        "| --- | ---: | ---: | ---: | ---: | ---: | ---: |",
+        f"| CartPole-v1 (anchor) | {cart:,.0f} | 1.00x | {cart_vec:,.0f} (CartPoleVectorEnv) | "
+        f"{ratio(cart_vec)} | | |",
     ]
-    for env_id, obs, single, sync, asyn in rows:
-        lines.append(f"| {env_id} | {obs} | {single:,.0f} | {sync:,.0f} | {asyn:,.0f} |")
-    lines.append(f"| CartPole-v1 (anchor, same run) | - | {cartpole:,.0f} | | |")
+    for env_id, s, b, g, npy in rows:
+        lines.append(
+            f"| {env_id} | {s:,.0f} | {ratio(s)} | {b:,.0f} | {ratio(b)} | {g:,.0f} | {npy:,.0f} |"
+        )
     lines += [
         "",
-        f"Recognize-v0 with fully random actions (2/3 of them declare, so most steps are resets): "
-        f"{rec_decl:,.0f} steps/s.",
-        "",
-        "| reset of Navigate-v0 | model | motion | median ms |",
-        "| --- | --- | --- | ---: |",
+        f"Batched Recognize-v0 with fully random actions (2/3 of the steps declare, so most "
+        f"steps are autoresets): {rec_decl:,.0f} env-steps/s ({ratio(rec_decl)}).  "
+        f'Batched Navigate-v0 on `scene="random"` (a pool of 64 scenes): {nav_rand:,.0f} '
+        f"env-steps/s ({ratio(nav_rand)}).",
     ]
-    for scene, model, motion, ms in resets:
-        what = "bundled `lab` (cached world)" if scene == "lab" else '`scene="random"` (new scene)'
-        lines.append(f"| {what} | {model} | {motion} | {ms:.2f} |")
+    if args.train:
+        tb = train_sps("batched", args.train_steps)
+        td = train_sps("dummy", args.train_steps)
+        lines += [
+            "",
+            f"`sensorplan train` PPO on Navigate-v0, shipped config (2 envs, n_steps 1024, "
+            f"batch 128, 10 epochs), {args.train_steps:,} steps, 1 torch thread: "
+            f"batched {tb:,.0f} env-steps/s, DummyVecEnv {td:,.0f} env-steps/s (wall clock, "
+            "updates included).",
+        ]
     text = "\n".join(lines) + "\n"
     print(text)
     out = Path(args.out)

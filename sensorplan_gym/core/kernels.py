@@ -9,15 +9,20 @@ same floating-point expressions in the same order, so their answers are bitwise 
 * the compiled loop (numba, no fast-math): N x B x M scalar iterations, no temporaries;
 * the numpy broadcast over ``(N, B, M)`` arrays, used without numba.
 
+Setting the environment variable ``SENSORPLAN_NO_NUMBA=1`` forces the numpy versions.
 Everything around them (angles, noise, disc robots) is shared numpy code in :mod:`.sensor`
 and :mod:`.collision`.
 """
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 
 try:  # pragma: no cover - exercised when numba is installed
+    if os.environ.get("SENSORPLAN_NO_NUMBA"):
+        raise ImportError("SENSORPLAN_NO_NUMBA is set")
     import numba
 
     HAVE_NUMBA = True

@@ -140,11 +140,9 @@ class RobotGridObs:
 
 
 def _rasters(sim: BatchSim, idx: np.ndarray, size: int) -> np.ndarray:
-    worlds = [sim.worlds[i] for i in idx.tolist()]
-    first = worlds[0]
-    if all(w is first for w in worlds):
-        return first.raster(size)[None]
-    return np.stack([w.raster(size) for w in worlds])
+    if sim._one_world:
+        return sim.worlds[0].raster(size)[None]
+    return np.stack([sim.worlds[i].raster(size) for i in idx.tolist()])
 
 
 class PlacementVectorObs:
@@ -154,6 +152,8 @@ class PlacementVectorObs:
         self.space = spaces.Box(low, np.ones(8 + 2 * n_beams, dtype=np.float32), dtype=np.float32)
 
     def __call__(self, sim: BatchSim, idx: np.ndarray) -> np.ndarray:
+        if sim._one_world:
+            return np.tile(self.of_world(sim.worlds[0]), (len(idx), 1))
         return np.stack([self.of_world(sim.worlds[i]) for i in idx.tolist()])
 
     def of_world(self, world: World) -> np.ndarray:

@@ -77,6 +77,7 @@ class BatchSim:
         self.segs = SegmentRows(N)  # walls, obstacles (and the target in Recognize)
         self.region_segs = SegmentRows(N)
         self.regions = np.empty(N, dtype=object)
+        self.spaces = np.empty(N, dtype=object)  # free space of the robot's centre
         self.hulls = np.zeros((N, 2, 1, 2))
         self.centers = np.zeros((N, 2, 2))
         self.fields = np.zeros((N, 1, 1))
@@ -139,6 +140,7 @@ class BatchSim:
         self.segs.set_row(i, r["segs"])
         self.region_segs.set_row(i, r["region_segs"])
         self.regions[i] = world.region
+        self.spaces[i] = world.robot_space
         k = r["hulls"].shape[1]
         hulls = self._grow("hulls", (2, k, 2))
         hulls[i, :, :k] = r["hulls"]
@@ -317,6 +319,13 @@ class BatchSim:
         dist = region_distance_batch(self._rows(self.region_segs, idx), x, y, inside)
         return inside & aim, inside, aim, dist
 
+    def in_free_space(self, idx: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """``(k,)`` bool: ``(x, y)`` is a free position of sub-environment ``idx``'s robot."""
+        spaces = self.spaces[self.sel(idx)]
+        if self._one_world and len(spaces) > 1:
+            return in_region_batch(spaces[0], x, y)
+        return in_region_batch(spaces, x, y)
+
     def sel(self, idx: np.ndarray) -> slice | np.ndarray:
         """An index for sub-environments ``idx`` (sorted, distinct): a slice (views, no
         copies) when they are all of them."""
@@ -347,7 +356,7 @@ class BatchSim:
         import shapely
 
         self.__dict__.update(state)
-        for g in self.regions:
+        for g in (*self.regions, *self.spaces):
             if g is not None:
                 shapely.prepare(g)
 

@@ -34,7 +34,6 @@ import math
 from typing import Any
 
 import numpy as np
-import shapely
 
 from .base import SensorPlanBatch, SensorPlanEnv
 
@@ -97,13 +96,7 @@ class PlacementBatch(SensorPlanBatch):
         reward, cols = self.evaluate(pose, idx)
         self.x[idx], self.y[idx], self.psi[idx] = pose.T
         self.placed[idx] = True
-        free = np.array(
-            [
-                shapely.contains_xy(self.worlds[i].robot_space, p[0], p[1])
-                for i, p in zip(idx.tolist(), pose, strict=True)
-            ],
-            dtype=bool,
-        )
+        free = self.in_free_space(idx, pose[:, 0], pose[:, 1])
         self.has_scan[idx] = False
         if free.any():
             self.sense(idx[free])

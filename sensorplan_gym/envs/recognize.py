@@ -63,29 +63,34 @@ class RecognizeBatch(RobotBatch):
         super().__init__(n, scene, **kwargs)
 
     def _place_target(self, i: int) -> None:
+        """Hide the target in G or H (uniformly) and add its edges to row ``i``'s segments."""
         w = self.worlds[i]
         rng = self.rngs[i]
         side = _G if rng.random() < 0.5 else _H
         which = "goal" if side == _G else "failure"
-        r = w.robot_radius
-        p = shapely.Point(self.x[i], self.y[i])
+        k = _hidden_target(w)
+        # the robot disc must not meet the target at the start: it cannot when it keeps clear
+        # of the hull of every placement (the must-see hull), else re-draw up to 20 times
+        xy = (self.x[i], self.y[i])
+        far = k["hulls"][side - 1].distance(shapely.Point(xy)) > w.robot_radius + 1e-9
         for _ in range(20):
             q = w.sample_in(which, rng)
             th = rng.uniform(0.0, 2 * math.pi) if w.theta is None else 0.0
             c, s = math.cos(th), math.sin(th)
             poly = w.target @ np.array([[c, s], [-s, c]]) + q
-            # keep the robot clear of the target at the start
-            if shapely.Polygon(poly).distance(p) > r + 1e-9:
+            if far or shapely.Polygon(poly).distance(shapely.Point(xy)) > w.robot_radius + 1e-9:
                 break
-        segs = np.concatenate([poly, np.roll(poly, -1, axis=0)], axis=1)
-        nrm = segment_normals(segs)
         self.side[i] = side
         self.target_polys[i] = poly
-        self.tsegs.set_row(i, pad_segments(segs, nrm, len(segs)))
-        allsegs = np.concatenate([w.segs, segs])
-        self.set_segments(
-            i, pad_segments(allsegs, np.concatenate([w.seg_normals, nrm]), len(allsegs))
-        )
+        if w.theta is None:
+            segs = np.concatenate([poly, np.roll(poly, -1, axis=0)], axis=1)
+            rows = pad_segments(segs, segment_normals(segs), len(segs))
+        else:  # a translate of the target's own edges
+            rows = k["rows"].copy()
+            rows[0] += q[0]
+            rows[1] += q[1]
+        self.tsegs.set_row(i, rows)
+        self.set_segments(i, np.concatenate([k["static"], rows], axis=1))
 
     def _reset_one(self, i: int, options: dict) -> None:
         self._start_from_options(i, {})
@@ -136,6 +141,24 @@ class RecognizeBatch(RobotBatch):
                 f"  declared {_LABEL[self.declared[i]]} (target in {_LABEL[self.side[i]]})"
             )
         return st
+
+
+def _hidden_target(w) -> dict:
+    """Per-world constants for placing the target (cached on the world): its edges at the
+    origin as ``(6, T)`` rows, the static rows, and the must-see hulls as polygons."""
+    k = w._cache.get("hidden_target")
+    if k is None:
+        poly = np.asarray(w.target, dtype=np.float64)
+        segs = np.concatenate([poly, np.roll(poly, -1, axis=0)], axis=1)
+        hulls = [shapely.Polygon(h) for h in w.must_see]
+        for h in hulls:
+            shapely.prepare(h)
+        k = w._cache["hidden_target"] = {
+            "rows": pad_segments(segs, segment_normals(segs), len(segs)),
+            "static": w.batch_rows()["segs"],
+            "hulls": hulls,
+        }
+    return k
 
 
 class RecognizeEnv(SensorPlanEnv):
