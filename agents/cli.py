@@ -3,6 +3,8 @@
     sensorplan train --env sensorplan/Navigate-v0 --algo ppo --timesteps 150000 --seed 0 --n-envs 2
     sensorplan evaluate --env sensorplan/Navigate-v0 --policies oracle random \\
         agents/pretrained/ppo_navigate_lab.zip --episodes 200 --seed 0
+    sensorplan train --backend rllib [--address ADDR]   (watchers, RLlib; agents.rllib_train)
+    sensorplan evaluate ... --backend ray [--address ADDR]   (episodes on Ray workers)
     sensorplan demo            (the paper's surveillance scenario end to end; see agents.demo)
     sensorplan convert plan.geojson scene.json   (GeoJSON / WKT / scene JSON, by extension;
                                                   see geometry.formats)
@@ -47,8 +49,25 @@ def build_parser() -> argparse.ArgumentParser:
         description="Train an SB3 agent with the YAML hyperparameters in "
         "agents/configs/<algo>.yaml (command-line values override).",
     )
-    t.add_argument("--env", required=True, help=ENV_CHOICES_HELP)
-    t.add_argument("--algo", required=True, choices=ALGOS)
+    t.add_argument("--env", default=None, help=ENV_CHOICES_HELP + " (required with --backend sb3)")
+    t.add_argument("--algo", default=None, choices=ALGOS, help="required with --backend sb3")
+    t.add_argument(
+        "--backend",
+        choices=("sb3", "rllib"),
+        default="sb3",
+        help="sb3: a stable-baselines3 baseline (default); rllib: multi-agent PPO with a "
+        "shared policy on the watch task (sensorplan_gym.watch_v0) with Ray RLlib, config "
+        "agents/configs/rllib_watch.yaml (see agents.rllib_train)",
+    )
+    t.add_argument(
+        "--address",
+        default=None,
+        help="rllib: attach to this Ray cluster ('auto', 'ray://head:10001') instead of "
+        "starting a local Ray instance",
+    )
+    t.add_argument(
+        "--iterations", type=int, default=None, help="rllib: training iterations (default: config)"
+    )
     t.add_argument(
         "--timesteps",
         type=int,
@@ -111,6 +130,13 @@ def build_parser() -> argparse.ArgumentParser:
     )
     e.add_argument("--out", default=None, help="output folder (default runs/eval_<env>_s<seed>)")
     e.add_argument("--no-plot", action="store_true")
+    e.add_argument(
+        "--backend",
+        choices=("local", "ray"),
+        default="local",
+        help="ray: play the episodes on Ray workers (same results as local; agents.ray_eval)",
+    )
+    e.add_argument("--address", default=None, help="ray: an existing Ray cluster's address")
 
     sub.add_parser(
         "demo", help="the paper's surveillance scenario end to end (agents.demo)", add_help=False
@@ -161,7 +187,22 @@ def main(argv: list[str] | None = None) -> int:
                 f"{len(scene.obstacles)} obstacles, {n_edges} edges"
             )
             return 0
+        if args.command == "train" and args.backend == "rllib":
+            from .rllib_train import train_rllib
+
+            res = train_rllib(
+                args.config,
+                seed=args.seed,
+                iterations=args.iterations,
+                address=args.address,
+                out=args.out,
+                env_kwargs=args.env_kwargs,
+            )
+            print(f"checkpoint: {res['checkpoint']}  ({res['wall_s']:.0f} s)")
+            return 0
         if args.command == "train":
+            if args.env is None or args.algo is None:
+                raise ValueError("--env and --algo are required with --backend sb3")
             from .train import train
 
             train(
@@ -192,6 +233,8 @@ def main(argv: list[str] | None = None) -> int:
                 env_kwargs=args.env_kwargs,
                 out=args.out,
                 plot=not args.no_plot,
+                backend=args.backend,
+                address=args.address,
             )
             return 0
     except (ValueError, KeyError, FileNotFoundError, NotImplementedError) as err:

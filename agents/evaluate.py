@@ -213,10 +213,16 @@ def evaluate(
     plot: bool = True,
     verbose: bool = True,
     threads: int | None = 1,
+    backend: str = "local",
+    address: str | None = None,
 ) -> dict[str, Any]:
     """Evaluate each policy spec (``"oracle"``, ``"random"``, a model zip) for ``episodes``
     episodes of ``env_id`` made with ``env_kwargs``; returns the results dict and, unless
-    ``out`` is ``False``, writes results.json / results.csv / results.png there."""
+    ``out`` is ``False``, writes results.json / results.csv / results.png there.
+    ``backend="ray"`` plays the episodes on Ray workers (:mod:`agents.ray_eval`; a local
+    instance, or the cluster at ``address``) with results identical to ``"local"``."""
+    if backend not in ("local", "ray"):
+        raise ValueError(f"backend must be 'local' or 'ray', got {backend!r}")
     import gymnasium as gym
 
     import sensorplan_gym  # noqa: F401 - registers the ids
@@ -276,7 +282,13 @@ def evaluate(
                 if diff and verbose:
                     print(f"note: {name} was trained with env kwargs {diff} (trained, evaluated)")
             t0 = time.perf_counter()
-            ep = run_episodes(env, policy, seeds)
+            if backend == "ray":
+                from .ray_eval import run_episodes_ray
+
+                ep = run_episodes_ray(env_id, env_kwargs, spec, seeds, seed=seed, address=address)
+            else:
+                ep = run_episodes(env, policy, seeds)
+            meta["backend"] = backend
             meta["eval_time_s"] = round(time.perf_counter() - t0, 2)
         finally:
             env.close()

@@ -6,10 +6,10 @@ there it stays).  At reset, from the episode's generator:
 1. A starts at a uniform free configuration at least ``min_start_dist`` (fraction of the
    scene diameter) from G and from H.  A translates at orientation 0.
 2. Its commanded motion is the shortest collision-free path to an end point drawn uniformly
-   in G (:meth:`WatchWorld.shortest_path`).  With probability ``p_fail`` the plan fails: at a
-   uniform fraction in ``[0.3, 0.7]`` of the way, A is deflected and follows the shortest
-   path from there to an end point in H that does not cross G (when one exists) -- A never
-   enters G and leaves it again.
+   in G (:meth:`WatchWorld.shortest_path`), not crossing H when such a path exists.  With
+   probability ``p_fail`` the plan fails: at a uniform fraction in ``[0.3, 0.7]`` of the way,
+   A is deflected and follows the shortest path from there to an end point in H that does
+   not cross G (when one exists) -- A never enters G and leaves it again.
 3. The plan is executed in exactly ``move_steps`` steps: the commanded progress per step is
    ``L / move_steps`` times ``1 + xi`` with ``|xi| <= speed_noise`` (renormalised to end at
    the path's end), plus a bounded drift ``e`` off the path: a Gaussian random walk clipped to
@@ -102,7 +102,9 @@ def plan_trajectory(
             last = "start too close to G or H"
             continue
         qg = world.sample_end("G", rng)
-        path = world.shortest_path(start, qg)
+        path = world.shortest_path(start, qg, avoid="H")
+        if path is None:
+            path = world.shortest_path(start, qg)
         if path is None:
             last = "G not reachable from the start"
             continue
@@ -115,7 +117,7 @@ def plan_trajectory(
             fault = _resample(path, np.array([u * L]))[0]
             cum = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(path, axis=0).T))])
             head = np.vstack([path[: int(np.searchsorted(cum, u * L, side="right"))], fault])
-            tail = world.shortest_path(fault, qh, avoid_goal=True)
+            tail = world.shortest_path(fault, qh, avoid="G")
             if tail is None:
                 tail = world.shortest_path(fault, qh)
             if tail is None:

@@ -32,7 +32,7 @@ from geometry import Scene
 from ..core.sensor import Segments
 from ..core.world import boundary_segments, segment_normals
 
-__all__ = ["WatchConfig", "WatchWorld", "get_watch_world"]
+__all__ = ["VisGraph", "WatchConfig", "WatchWorld", "get_watch_world"]
 
 MODELS = ("complete", "partial")
 
@@ -114,7 +114,7 @@ class WatchWorld:
     # ---- pickling: shapely's "prepared" flag does not survive -----------------------------
     def __setstate__(self, state: dict) -> None:
         self.__dict__.update(state)
-        for g in (self.free_space, self.cspace, self.cspace_m, self.cspace_noG):
+        for g in (self.free_space, self.cspace, self.cspace_m):
             shapely.prepare(g)
 
     # ---- robot A's configuration space ------------------------------------------------------
@@ -132,11 +132,9 @@ class WatchWorld:
         #: margin kept between A's planned path and the C-space boundary
         self.margin = 0.01 * self.diameter
         self.cspace_m = cs.buffer(-self.margin, quad_segs=8, join_style="mitre")
-        keep_out = self.goal_geom.buffer(self.margin)
-        self.cspace_noG = shapely.difference(self.cspace_m, keep_out)
-        for geom in (self.cspace, self.cspace_m, self.cspace_noG):
+        for geom in (self.cspace, self.cspace_m):
             shapely.prepare(geom)
-        self._graphs: dict[str, tuple] = {}
+        self._graphs: dict[str, VisGraph] = {}
 
     def clearance(self, x: float, y: float) -> float:
         """Distance from configuration ``(x, y)`` to the boundary of A's exact C-space (how far
@@ -145,58 +143,20 @@ class WatchWorld:
             return 0.0
         return self.cspace_segs.clearance(x, y)
 
-    def _graph(self, which: str):
-        g = self._graphs.get(which)
-        if g is None:
-            dom = self.cspace_m if which == "main" else self.cspace_noG
-            nodes = np.unique(shapely.get_coordinates(shapely.boundary(dom)), axis=0)
-            n = len(nodes)
-            i, j = np.triu_indices(n, 1)
-            lines = shapely.linestrings(np.stack([nodes[i], nodes[j]], axis=1))
-            ok = shapely.covers(dom, lines)
-            w = np.hypot(*(nodes[i[ok]] - nodes[j[ok]]).T)
-            g = self._graphs[which] = (dom, nodes, i[ok], j[ok], w)
-        return g
-
-    def shortest_path(self, a, b, *, avoid_goal: bool = False) -> np.ndarray | None:
+    def shortest_path(self, a, b, *, avoid: str | None = None) -> np.ndarray | None:
         """Shortest path of A's reference point from ``a`` to ``b`` inside the margin-shrunk
-        C-space (``avoid_goal``: also outside G grown by the margin), as ``(N, 2)`` way points,
-        or ``None`` when there is none."""
-        from scipy.sparse import coo_matrix
-        from scipy.sparse.csgraph import dijkstra
-
-        dom, nodes, ii, jj, w = self._graph("noG" if avoid_goal else "main")
-        a = np.asarray(a, dtype=np.float64)
-        b = np.asarray(b, dtype=np.float64)
-        if shapely.covers(dom, shapely.linestrings([a, b])):
-            return np.stack([a, b])
-        n = len(nodes)
-        ends = np.stack([a, b])
-        # edges from a (node n) and b (node n + 1) to every visible graph node
-        segs = shapely.linestrings(
-            np.stack([np.repeat(ends, n, axis=0), np.tile(nodes, (2, 1))], axis=1)
-        )
-        vis = shapely.covers(dom, segs).reshape(2, n)
-        rows = [ii, jj]
-        cols = [jj, ii]
-        ws = [w, w]
-        for k in range(2):
-            idx = np.nonzero(vis[k])[0]
-            d = np.hypot(*(nodes[idx] - ends[k]).T)
-            rows += [np.full(len(idx), n + k), idx]
-            cols += [idx, np.full(len(idx), n + k)]
-            ws += [d, d]
-        M = coo_matrix(
-            (np.concatenate(ws), (np.concatenate(rows), np.concatenate(cols))), shape=(n + 2, n + 2)
-        ).tocsr()
-        dist, pred = dijkstra(M, indices=n, return_predecessors=True)
-        if not np.isfinite(dist[n + 1]):
-            return None
-        path = [n + 1]
-        while path[-1] != n:
-            path.append(int(pred[path[-1]]))
-        pts = np.concatenate([nodes, ends])[path[::-1]]
-        return pts
+        C-space -- with ``avoid="G"`` (``"H"``) also outside G (H) grown by the margin, so that
+        A does not pass through the region it must not end in -- as ``(N, 2)`` way points, or
+        ``None`` when there is none."""
+        key = avoid or "main"
+        g = self._graphs.get(key)
+        if g is None:
+            dom = self.cspace_m
+            if avoid is not None:
+                region = self.goal_geom if avoid == "G" else self.failure_geom
+                dom = shapely.difference(dom, region.buffer(self.margin))
+            g = self._graphs[key] = VisGraph(dom)
+        return g.shortest_path(a, b)
 
     def sample_free_config(self, rng: np.random.Generator, tries: int = 10_000) -> np.ndarray:
         """A uniform point of the margin-shrunk C-space (rejection from the bounding box)."""
@@ -298,6 +258,65 @@ class WatchWorld:
         """All the given point sets inside the field of view from ``(x, y)`` aimed at ``psi``
         (each set's angular interval as seen from the point)."""
         return all(self._in_fov(x, y, psi, h) for h in hulls)
+
+
+class VisGraph:
+    """Shortest paths inside a polygonal domain: the visibility graph of its boundary vertices
+    (built once, ``shapely.covers`` on every vertex pair, vectorised), joined per query to the
+    two end points, and Dijkstra (scipy).  Paths are polylines through domain vertices; they
+    touch the domain's boundary there (callers shrink the domain by a margin first)."""
+
+    def __init__(self, domain: shapely.Geometry) -> None:
+        self.domain = domain
+        shapely.prepare(domain)
+        nodes = np.unique(shapely.get_coordinates(shapely.boundary(domain)), axis=0)
+        i, j = np.triu_indices(len(nodes), 1)
+        ok = shapely.covers(domain, shapely.linestrings(np.stack([nodes[i], nodes[j]], axis=1)))
+        self.nodes = nodes
+        self.ii, self.jj = i[ok], j[ok]
+        self.w = np.hypot(*(nodes[self.ii] - nodes[self.jj]).T)
+
+    def __setstate__(self, st: dict) -> None:
+        self.__dict__.update(st)
+        shapely.prepare(self.domain)
+
+    def contains(self, x: float, y: float) -> bool:
+        return bool(shapely.contains_xy(self.domain, x, y))
+
+    def shortest_path(self, a, b) -> np.ndarray | None:
+        """Way points ``(N, 2)`` of a shortest path from ``a`` to ``b`` within the domain
+        (``None`` if there is none, e.g. an end point outside it)."""
+        from scipy.sparse import coo_matrix
+        from scipy.sparse.csgraph import dijkstra
+
+        dom, nodes = self.domain, self.nodes
+        a = np.asarray(a, dtype=np.float64)
+        b = np.asarray(b, dtype=np.float64)
+        if shapely.covers(dom, shapely.linestrings([a, b])):
+            return np.stack([a, b])
+        n = len(nodes)
+        ends = np.stack([a, b])
+        segs = shapely.linestrings(
+            np.stack([np.repeat(ends, n, axis=0), np.tile(nodes, (2, 1))], axis=1)
+        )
+        vis = shapely.covers(dom, segs).reshape(2, n)
+        rows, cols, ws = [self.ii, self.jj], [self.jj, self.ii], [self.w, self.w]
+        for k in range(2):
+            idx = np.nonzero(vis[k])[0]
+            d = np.hypot(*(nodes[idx] - ends[k]).T)
+            rows += [np.full(len(idx), n + k), idx]
+            cols += [idx, np.full(len(idx), n + k)]
+            ws += [d, d]
+        M = coo_matrix(
+            (np.concatenate(ws), (np.concatenate(rows), np.concatenate(cols))), shape=(n + 2, n + 2)
+        ).tocsr()
+        dist, pred = dijkstra(M, indices=n, return_predecessors=True)
+        if not np.isfinite(dist[n + 1]):
+            return None
+        path = [n + 1]
+        while path[-1] != n:
+            path.append(int(pred[path[-1]]))
+        return np.concatenate([nodes, ends])[path[::-1]]
 
 
 def _sum_convex_all(scene: Scene, negK: np.ndarray) -> shapely.Geometry:
