@@ -6,8 +6,9 @@ from __future__ import annotations
 
 import math
 import numbers
+import time
 import weakref
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -244,6 +245,40 @@ def check_eps_pos(scene: Scene, value: Any) -> float:
             "units): a placement that uncertain could be anywhere in the room"
         )
     return v
+
+
+@dataclass(frozen=True)
+class Budget:
+    """Time limit and progress reporting of a swept query.
+
+    ``deadline`` is a ``time.monotonic()`` value (None: no limit); ``progress(done,
+    total)`` is called after every swept edge of the region's boundary (edges of G,
+    then of H for paper 5.2); ``what`` names the query in the timeout message."""
+
+    deadline: float | None = None
+    progress: Callable[[int, int], None] | None = None
+    what: str = "the swept query"
+    offset: int = 0
+    total: int | None = None
+
+    @staticmethod
+    def make(timeout: Any, progress: Any, what: str) -> Budget:
+        """Validate ``timeout`` (seconds, > 0, or None) and ``progress`` (callable or None)."""
+        if timeout is not None:
+            if not _real(timeout) or not math.isfinite(float(timeout)) or float(timeout) <= 0:
+                raise ValueError(
+                    f"timeout must be a number of seconds > 0 or None, got {timeout!r}"
+                )
+        if progress is not None and not callable(progress):
+            raise ValueError(
+                f"progress must be a callable progress(done, total) or None, got {progress!r}"
+            )
+        deadline = None if timeout is None else time.monotonic() + float(timeout)
+        return Budget(deadline, progress, what)
+
+    def report(self, done: int, total: int) -> None:
+        if self.progress is not None:
+            self.progress(self.offset + done, total if self.total is None else self.total)
 
 
 def check_eps(name: str, value: float) -> float:

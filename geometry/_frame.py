@@ -30,6 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import shapely
+import shapely.errors
 
 __all__ = ["Frame", "IDENTITY", "frame_params", "world_messages", "to_world_point"]
 
@@ -95,7 +96,11 @@ class Frame:
         w = shapely.transform(g, lambda c: c * self.scale + np.array([self.ox, self.oy]))
         if w.is_empty or w.is_valid or g.geom_type not in ("Polygon", "MultiPolygon"):
             return w
-        return _areal(shapely.make_valid(w))
+        try:
+            fixed = shapely.make_valid(w, method="structure", keep_collapsed=False)
+        except shapely.errors.GEOSException:  # pragma: no cover - GEOS corner cases
+            fixed = shapely.buffer(w, 0.0)
+        return _areal(fixed)
 
     def to_world_pts(self, p: np.ndarray) -> np.ndarray:
         return np.asarray(p, dtype=float) * self.scale + np.array([self.ox, self.oy])

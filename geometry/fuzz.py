@@ -337,7 +337,9 @@ class Finding:
     detail: str
 
 
-def _timed(fn: Callable[[], Any], name: str, out: list[Finding], times: dict) -> Any:
+def _timed(
+    fn: Callable[[], Any], name: str, out: list[Finding], times: dict, hang_s: float = HANG_S
+) -> Any:
     t0 = time.perf_counter()
     try:
         r = fn()
@@ -348,7 +350,7 @@ def _timed(fn: Callable[[], Any], name: str, out: list[Finding], times: dict) ->
         r = None
     dt = time.perf_counter() - t0
     times[name] = dt
-    if dt > HANG_S:
+    if dt > hang_s:
         out.append(Finding("hang", name, f"{dt:.1f} s"))
     return r
 
@@ -383,10 +385,16 @@ def _translated(d: dict, o: float) -> dict:
 
 
 def check_scene(
-    d: dict[str, Any], *, swept: bool = False, translate: bool = True, seed: int = 0
+    d: dict[str, Any],
+    *,
+    swept: bool = False,
+    translate: bool = True,
+    seed: int = 0,
+    hang_s: float = HANG_S,
 ) -> tuple[list[Finding], dict[str, float]]:
     """Run every query type on the scene dictionary ``d`` (see the module docstring);
-    returns the findings and the time of every query (seconds)."""
+    returns the findings and the time of every query (seconds).  ``hang_s``: the
+    time limit of one query (wall clock)."""
     d = {k: v for k, v in d.items() if k != "features"}
     s = Scene.from_dict(d)
     rng = np.random.default_rng(seed)
@@ -401,7 +409,7 @@ def check_scene(
     poly_gh = len(s.goal) > 1 and len(s.failure) > 1
 
     def run(name: str, fn: Callable[[], Any]) -> Any:
-        r = _timed(fn, name, out, times)
+        r = _timed(fn, name, out, times, hang_s)
         if r is None:
             return None
         if r.geom_type not in ("Polygon", "MultiPolygon") or not r.is_valid:

@@ -21,6 +21,7 @@ polygon gives the paper's *visibility polygons*; with aim uncertainty
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -29,6 +30,7 @@ import shapely
 from ._common import (
     OUTER,
     QUAD_SEGS,
+    Budget,
     as_scene,
     check_aim,
     check_eps,
@@ -69,6 +71,8 @@ def partial_region(
     eps_aim: float = 0.0,
     tol: float | None = None,
     conservative: bool = False,
+    timeout: float | None = None,
+    progress: Callable[[int, int], None] | None = None,
 ) -> shapely.Geometry:
     """Sensor placements from which some point of the target is visible.
 
@@ -92,6 +96,11 @@ def partial_region(
     tol : only with ``target_in``: the shadow boundaries traced by free vertices
         (lines and conics) are emitted as polylines whose chords stay within
         ``tol`` (scene units) of the curves; default ``1e-4 * scene.diameter``.
+    timeout : only with ``target_in``: a time limit in seconds; past it the query
+        raises :class:`~geometry.sweep.QueryTimeout` (a ``TimeoutError``) naming
+        the edges of the region's boundary left to sweep.  ``None``: no limit.
+    progress : only with ``target_in``: ``progress(done, total)`` is called after
+        every swept edge of the region's boundary.
     conservative : only with ``target_in``: grow the shadows by ``tol``, so that
         the answer lies inside the exact region as long as the sweep misses no
         shadow deeper than ``tol`` (none deeper than 0.003 ``tol`` was measured;
@@ -113,6 +122,9 @@ def partial_region(
         tol = check_eps("tol", tol)
         if tol <= 0:
             raise ValueError(f"tol must be > 0, got {tol!r}")
+    budget = Budget.make(timeout, progress, "partial_region(target_in=...)")
+    if target_in is None and (timeout is not None or progress is not None):
+        raise ValueError("timeout and progress apply to a moving target (target_in=...) only")
     fr = scene.frame
     with world_messages(fr):
         out = _partial_region(
@@ -124,6 +136,7 @@ def partial_region(
             eps_aim,
             fr.length(tol),
             conservative,
+            budget,
         )
     return fr.to_world(out)
 
@@ -137,12 +150,15 @@ def _partial_region(
     eps_aim: float,
     tol: float | None,
     conservative: bool,
+    budget: Budget | None = None,
 ) -> shapely.Geometry:
     """:func:`partial_region` on a scene in its local frame (arguments checked)."""
     if target_in is not None:
         if target_at is not None:
             raise ValueError("give exactly one of target_at=(x, y, theta) or target_in=<region>")
-        return _swept_region(scene, target_in, theta, eps_pos, eps_aim, tol, conservative)
+        return _swept_region(
+            scene, target_in, theta, eps_pos, eps_aim, tol, conservative, budget=budget
+        )
     if tol is not None or conservative:
         raise ValueError("tol and conservative apply to a moving target (target_in=...) only")
     if target_at is None:
@@ -169,8 +185,10 @@ def _swept_region(
     tol: float | None,
     conservative: bool,
     strips: list[shapely.Geometry] | None = None,
+    budget: Budget | None = None,
 ) -> shapely.Geometry:
     """The partial region of a target translating through ``target_in``."""
+    budget = budget or Budget()
     if theta is None:
         raise NotImplementedError(ROTATING_PARTIAL)
     tol = swept_tol(scene, tol)
@@ -185,6 +203,9 @@ def _swept_region(
         strips=strips,
         eps_aim=eps_aim,
         tol=tol,
+        deadline=budget.deadline,
+        progress=budget.report if budget.progress is not None else None,
+        what=budget.what,
     )
     if conservative:
         shadows = shapely.buffer(shadows, tol * OUTER, quad_segs=QUAD_SEGS)

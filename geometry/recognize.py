@@ -20,13 +20,16 @@ and from which those two outcomes cannot be confused.
 
 from __future__ import annotations
 
+import dataclasses
 import math
+from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 import numpy as np
 import shapely
 
 from ._common import (
+    Budget,
     _triangles,
     as_scene,
     check_aim,
@@ -57,6 +60,8 @@ def recognizable_region(
     eps_aim: float = 0.0,
     tol: float | None = None,
     conservative: bool = False,
+    timeout: float | None = None,
+    progress: Callable[[int, int], None] | None = None,
 ) -> shapely.Geometry:
     """Placements from which "target in G" and "target in H" are told apart.
 
@@ -72,6 +77,10 @@ def recognizable_region(
         change *where* to stand; the aim itself is checked against the field of
         view by the caller.
 
+    timeout, progress : partial model with polygonal G and H (paper 5.2) only: a time
+        limit in seconds (:class:`~geometry.sweep.QueryTimeout` past it, naming what
+        was left) and a ``progress(done, total)`` callback after every swept edge of
+        G and then of H (see :func:`partial_region`).
     tol, conservative : partial model with polygonal G and H (paper 5.2) only:
         the polyline tolerance of the swept shadows (default 1e-4 of the scene
         diameter) and whether to grow the shadows by it so that the answer lies
@@ -93,10 +102,18 @@ def recognizable_region(
         tol = check_eps("tol", tol)
         if tol <= 0:
             raise ValueError(f"tol must be > 0, got {tol!r}")
+    budget = Budget.make(timeout, progress, "recognizable_region(model='partial')")
     fr = scene.frame
     with world_messages(fr):
         out = _recognizable_region(
-            scene.local, model, theta, fr.length(eps_pos), eps_aim, fr.length(tol), conservative
+            scene.local,
+            model,
+            theta,
+            fr.length(eps_pos),
+            eps_aim,
+            fr.length(tol),
+            conservative,
+            budget,
         )
     return fr.to_world(out)
 
@@ -109,6 +126,7 @@ def _recognizable_region(
     eps_aim: float,
     tol: float | None,
     conservative: bool,
+    budget: Budget | None = None,
 ) -> shapely.Geometry:
     """:func:`recognizable_region` on a scene in its local frame (arguments checked)."""
     if model == "complete":
@@ -127,7 +145,9 @@ def _recognizable_region(
             "(paper 5.1) or both polygons (paper 5.2); this scene mixes a point and a polygon"
         )
     if g.geom_type == "Polygon":
-        return _swept_recognizable(scene, th, eps_pos, eps_aim, swept_tol(scene, tol), conservative)
+        return _swept_recognizable(
+            scene, th, eps_pos, eps_aim, swept_tol(scene, tol), conservative, budget or Budget()
+        )
     if tol is not None or conservative:
         raise ValueError("tol and conservative apply to polygonal G and H only")
     regions = []
@@ -140,9 +160,7 @@ def _recognizable_region(
         ring_cw, wanted_cw = ring[::-1], np.roll(wanted[::-1], -1)
         reg = weak_visibility(scene_domain(scene), ring_cw, wanted_cw, eps_aim)
         # clipped to the free space (see partial._partial_region)
-        reg = polygonal(
-            shapely.intersection(reg, shapely.difference(scene.free_space, spec.area))
-        )
+        reg = polygonal(shapely.intersection(reg, shapely.difference(scene.free_space, spec.area)))
         if eps_pos > 0:
             reg = shrink_for_position(reg, shapely.difference(scene.free_space, spec.area), eps_pos)
         regions.append(reg)
@@ -150,11 +168,20 @@ def _recognizable_region(
 
 
 def _swept_recognizable(
-    scene: Scene, theta: float, eps_pos: float, eps_aim: float, tol: float, conservative: bool
+    scene: Scene,
+    theta: float,
+    eps_pos: float,
+    eps_aim: float,
+    tol: float,
+    conservative: bool,
+    budget: Budget,
 ) -> shapely.Geometry:
     """Paper 5.2: the non-overlap part A'(q) of the target swept through G and
     through H; the two partial regions intersected."""
     target = _ccw_ring(scene.target_at(0.0, 0.0, theta))
+    n_g, n_h = (
+        len(shapely.get_coordinates(scene.region(w).boundary)) - 1 for w in ("goal", "failure")
+    )
     regions = [
         _swept_region(
             scene,
@@ -165,8 +192,9 @@ def _swept_recognizable(
             tol,
             conservative,
             strips=overlap_strips(target, scene.region(other), *_accuracy(scene)),
+            budget=dataclasses.replace(budget, offset=off, total=n_g + n_h),
         )
-        for me, other in (("goal", "failure"), ("failure", "goal"))
+        for (me, other), off in ((("goal", "failure"), 0), (("failure", "goal"), n_g))
     ]
     return polygonal(shapely.intersection(*regions))
 

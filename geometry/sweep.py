@@ -45,6 +45,8 @@ between).  What this does not prove is listed in docs/DESIGN.md.
 
 from __future__ import annotations
 
+import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -55,7 +57,17 @@ from . import visindex as _visindex
 from ._common import polygonal
 from ._vis import TAU, Domain, RayEscapeError, gaps_many
 
-__all__ = ["Sweeper", "star_center", "swept_shadows"]
+__all__ = ["QueryTimeout", "Sweeper", "star_center", "swept_shadows"]
+
+
+class QueryTimeout(TimeoutError):
+    """A swept query ran past its ``timeout``.  The message names the query, the
+    limit and what was left (edges of the region's boundary not yet swept)."""
+
+
+class _Expired(Exception):
+    """Internal: the sweeper's deadline passed (turned into :class:`QueryTimeout`)."""
+
 
 #: Segment tags inside visibility domains built here.
 _ENV, _WANTED, _UNWANTED = 0, 1, 2
@@ -103,6 +115,8 @@ class Sweeper:
     max_depth: int = 6
     bisect_steps: int = 14
     probes: int = 4
+    #: ``time.monotonic()`` value after which the sweep stops (None: no limit).
+    deadline: float | None = None
     _cut_segs: np.ndarray = field(init=False, repr=False)
     _cut_edge: np.ndarray = field(init=False, repr=False)
 
@@ -425,6 +439,7 @@ class Sweeper:
         cover: dict[tuple, list] = {}
         todo = [(a, b, 0) for a, b in zip(ts[:-1], ts[1:], strict=True)]
         while todo:
+            self._check_time()
             a, b, depth = todo.pop()
             known = shapely.union(frame(a)[0], frame(b)[0])
             for t, toward in ((a, b), (b, a)):
@@ -444,6 +459,10 @@ class Sweeper:
                 pieces.append(frames[gap][0])
                 todo += [(a, gap, depth + 1), (gap, b, depth + 1)]
         return pieces, stats
+
+    def _check_time(self) -> None:
+        if self.deadline is not None and time.monotonic() > self.deadline:
+            raise _Expired
 
     def _uncovered(self, edges: list, t: float, toward: float, known, q0, dq) -> list:
         """The edges whose sweep from t to ``toward`` (assuming it lives that long)
@@ -488,6 +507,7 @@ class Sweeper:
         todo = [(a, b, 0) for a, b in zip(ts[:-1], ts[1:], strict=True)]
         out = set(ts)
         while todo:
+            self._check_time()
             a, b, depth = todo.pop()
             if depth >= self.max_depth:
                 continue
@@ -768,10 +788,17 @@ def swept_shadows(
     strips: list[shapely.Geometry] | None = None,
     eps_aim: float = 0.0,
     tol: float,
+    deadline: float | None = None,
+    progress: Callable[[int, int], None] | None = None,
+    what: str = "the swept query",
 ) -> tuple[shapely.Geometry, dict]:
     """Union of the partial-visibility shadows S(q) over the reference points q
     of ``region`` (a Point or Polygon), for the target outline ``target``
     (counter-clockwise, reference point at the origin, fixed orientation).
+
+    ``deadline`` (a ``time.monotonic()`` value) stops the sweep with
+    :class:`QueryTimeout` (naming ``what`` and the edges left); ``progress(done,
+    total)`` is called after every swept edge of the region's boundary.
 
     The target must be star-shaped; the sweep runs over the boundary of the
     region with the reference point moved into the target's kernel (the swept
@@ -790,7 +817,7 @@ def swept_shadows(
         shapely.multipoints((ring0[:, None, :] + _region_pts(region)[None, :, :]).reshape(-1, 2))
     )
     hull_pts = np.asarray(shapely.orient_polygons(hull, exterior_cw=False).exterior.coords)[:-1]
-    sw = Sweeper(env, free, ring0, hull_pts, strips, eps_aim, tol)
+    sw = Sweeper(env, free, ring0, hull_pts, strips, eps_aim, tol, deadline=deadline)
     pieces: list[shapely.Geometry] = []
     stats = {"samples": 0, "edges": 0, "refined": 0}
     if region.geom_type == "Point":
@@ -798,13 +825,27 @@ def swept_shadows(
         pieces.append(sw.shadow(q)[0])
         stats["samples"] = 1
     else:
-        for ring in _rings(shapely.orient_polygons(region, exterior_cw=False)):
-            v = np.asarray(ring.coords)[:, :2]
-            for a, b in zip(v[:-1], v[1:], strict=True):
+        segs = [
+            (a, b)
+            for ring in _rings(shapely.orient_polygons(region, exterior_cw=False))
+            for a, b in zip(
+                np.asarray(ring.coords)[:-1, :2], np.asarray(ring.coords)[1:, :2], strict=True
+            )
+        ]
+        for done, (a, b) in enumerate(segs):
+            try:
                 got, st = sw.along(a, b)
-                pieces += got
-                for k in stats:
-                    stats[k] += st[k]
+            except _Expired:
+                raise QueryTimeout(
+                    f"{what} ran past its timeout after sweeping {done} of the {len(segs)} "
+                    f"edges of the region's boundary ({len(segs) - done} left, the current "
+                    "one included); raise timeout= or give timeout=None"
+                ) from None
+            pieces += got
+            for k in stats:
+                stats[k] += st[k]
+            if progress is not None:
+                progress(done + 1, len(segs))
     return polygonal(shapely.union_all(pieces)), stats
 
 

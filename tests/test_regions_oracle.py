@@ -380,6 +380,9 @@ def _eps_check(sd: SceneData, tally: Tally, kind: str, n: int) -> None:
                 # candidates: an interior point of every piece of the implementation's shadows
                 # within the disc (the oracle must confirm it), then points of the disc itself
                 near = shapely.intersection(shadows, Point(p).buffer(0.999 * eps, quad_segs=32))
+                # opened by 1e-7 D first: a shadow piece with a zero-width spike along an
+                # obstacle edge (boolean noise) may otherwise offer a point on the spike
+                near = shapely.buffer(near, -1e-7 * sc.diameter, join_style="mitre")
                 cands = [
                     np.asarray(g.point_on_surface().coords[0])
                     for g in shapely.get_parts(near)

@@ -347,3 +347,35 @@ def test_accuracy_fields_validated_and_scaled():
     s = Scene.from_dict({**ROOM, "sensor": {"range_acc": 0.016}})
     assert s.range_acc == 0.016 and s.local.range_acc == 0.016 / s.frame.scale
     assert Scene.from_dict(ROOM).range_acc == pytest.approx(1e-6 * ROOM_DIAM)
+
+
+# -- time limits and progress of the swept queries ------------------------------------------
+
+
+def test_swept_timeout_and_progress():
+    from geometry.sweep import QueryTimeout
+
+    d = {**ROOM, "goal": [[1.5, 1], [2.5, 1], [2.5, 2], [1.5, 2]]}
+    d["failure"] = [[7.5, 6], [8.5, 6], [8.5, 7], [7.5, 7]]
+    s = Scene.from_dict(d)
+    seen: list[tuple[int, int]] = []
+    r = partial_region(s, target_in="goal", theta=0.0, progress=lambda i, n: seen.append((i, n)))
+    assert seen == [(1, 4), (2, 4), (3, 4), (4, 4)] and r.area > 0
+    with pytest.raises(QueryTimeout, match=r"partial_region\(target_in=...\) ran past its "
+                       r"timeout after sweeping 0 of the 4 edges"):  # fmt: skip
+        partial_region(s, target_in="goal", theta=0.0, timeout=1e-9)
+    assert issubclass(QueryTimeout, TimeoutError)
+    seen.clear()
+    recognizable_region(
+        s, model="partial", theta=0.0, timeout=60, progress=lambda i, n: seen.append((i, n))
+    )
+    assert seen == [(k, 8) for k in range(1, 9)]
+    with pytest.raises(QueryTimeout, match="recognizable_region"):
+        recognizable_region(s, model="partial", theta=0.0, timeout=1e-9)
+    for bad in (0, -1, "5", float("inf")):
+        with pytest.raises(ValueError, match="timeout"):
+            partial_region(s, target_in="goal", theta=0.0, timeout=bad)
+    with pytest.raises(ValueError, match="progress"):
+        partial_region(s, target_in="goal", theta=0.0, progress=3)
+    with pytest.raises(ValueError, match="target_in"):
+        partial_region(s, target_at=(2, 1.5, 0), timeout=5)
