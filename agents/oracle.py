@@ -169,6 +169,7 @@ class _Driver:
         self.looking = False  # arrived at the viewpoint once: now observing
         self.n_classified = -1
         self.decision = None
+        self.latched = 0.0  # a declaration, repeated until the env takes it (declare_hold)
         self.looks: list[float] | None = None
 
     # -- planning -----------------------------------------------------------------------
@@ -319,6 +320,11 @@ class OraclePolicy:
             kind = type(e).__name__
             if kind not in ("PlacementEnv", "NavigateEnv", "RecognizeEnv"):
                 raise TypeError(f"OraclePolicy supports the sensorplan envs, got {kind}")
+            if getattr(e.batch, "action_type", "continuous") != "continuous":
+                raise TypeError(
+                    "OraclePolicy acts in the continuous action space; make the env with "
+                    "action_type='continuous' (the default)"
+                )
             e.spec_kind = kind.replace("Env", "").lower()
         self.drivers = [_Driver(e) for e in self.envs]
 
@@ -372,9 +378,12 @@ class OraclePolicy:
         horizon = env.max_steps or (env.spec.max_episode_steps if env.spec else None) or 200
         final = drv.steps >= horizon - 1
         drv.looking = drv.looking or drv.arrived
-        if drv.looking or final or drv.plan.status != "ok":
+        if drv.latched:
+            decide = drv.latched
+        elif drv.looking or final or drv.plan.status != "ok":
             drv.observe_target()
             decide = drv.decide(final)
+            drv.latched = decide
             if decide == 0.0 and drv.looking:
                 # re-aim: sweep the gaps between beams around the planned aim (or around
                 # the aims at G and at H in turn when no single aim sees both): a triangle

@@ -11,7 +11,10 @@ obstacles, G, H), its own pose, and its sensor readings.  The hidden target of
     frame divided by the scene diameter (2 + 2), then per beam the distance
     divided by the sensor's reach (``n_beams`` values in [0, 1]) and the surface
     normal in the robot's frame (``n_beams`` x-components, then ``n_beams``
-    y-components; zeros where nothing was hit).
+    y-components; zeros where nothing was hit).  With ``map_ranges=True``, ``n_beams``
+    more values: the range each beam would read on the static map (walls and obstacles,
+    no target, no noise) from the commanded pose, divided by the reach -- what a robot
+    carrying the map predicts (length ``8 + 4 * n_beams``).
 
     Placement, length ``8 + 2 * n_beams``: centres of G and H scaled to [-1, 1],
     the width and height of G and H's bounding boxes divided by the scene's span,
@@ -75,12 +78,15 @@ def _scaled(world: World, x: float, y: float) -> tuple[float, float]:
 
 
 class RobotVectorObs:
-    def __init__(self, n_beams: int, grid_size: int = 64) -> None:
+    def __init__(self, n_beams: int, grid_size: int = 64, map_ranges: bool = False) -> None:
         self.n = n_beams
         n = n_beams
-        low = np.concatenate([-np.ones(8), np.zeros(n), -np.ones(2 * n)]).astype(np.float32)
-        high = np.ones(8 + 3 * n, dtype=np.float32)
-        self.space = spaces.Box(low, high, dtype=np.float32)
+        self.map_ranges = map_ranges
+        m = n if map_ranges else 0
+        low = np.concatenate([-np.ones(8), np.zeros(n), -np.ones(2 * n), np.zeros(m)])
+        self.space = spaces.Box(
+            low.astype(np.float32), np.ones(8 + 3 * n + m, dtype=np.float32), dtype=np.float32
+        )
 
     def __call__(self, sim: BatchSim, idx: np.ndarray) -> np.ndarray:
         sel = sim.sel(idx)
@@ -88,7 +94,7 @@ class RobotVectorObs:
         K = sim.obs_consts[sel]  # lo, 2 / span, 1 / diameter, 1 / reach, G, H centres
         c, s = np.cos(psi), np.sin(psi)
         n = self.n
-        out = np.empty((len(x), 8 + 3 * n))
+        out = np.empty((len(x), self.space.shape[0]))
         out[:, 0] = (x - K[:, 0]) * K[:, 2] - 1.0
         out[:, 1] = (y - K[:, 1]) * K[:, 3] - 1.0
         np.clip(out[:, :2], -1.0, 1.0, out=out[:, :2])
@@ -102,7 +108,9 @@ class RobotVectorObs:
         out[:, 8 : 8 + n] = sim.scan_dist[sel] * K[:, 5:6]
         nrm = sim.scan_normal[sel]  # robot-frame x's, then y's
         out[:, 8 + n : 8 + 2 * n] = c1 * nrm[..., 0] + s1 * nrm[..., 1]
-        out[:, 8 + 2 * n :] = c1 * nrm[..., 1] - s1 * nrm[..., 0]
+        out[:, 8 + 2 * n : 8 + 3 * n] = c1 * nrm[..., 1] - s1 * nrm[..., 0]
+        if self.map_ranges:
+            out[:, 8 + 3 * n :] = sim.map_dist[sel] * K[:, 5:6]
         # every entry is within its bounds up to rounding of order 1e-16, which the float32
         # conversion absorbs (values within 2**-25 of +-1 round to +-1)
         return out.astype(np.float32)
@@ -191,8 +199,11 @@ class PlacementGridObs:
         return np.broadcast_to(_rasters(sim, idx, self.size), (len(idx), *self.space.shape)).copy()
 
 
-def make_observation(kind: str, obs_type: str, n_beams: int, grid_size: int):
-    """The observation builder for env ``kind`` ("robot" or "placement") and ``obs_type``."""
+def make_observation(
+    kind: str, obs_type: str, n_beams: int, grid_size: int, *, map_ranges: bool = False
+):
+    """The observation builder for env ``kind`` ("robot" or "placement") and ``obs_type``;
+    ``map_ranges``: robot vector observations carry the map-predicted ranges too."""
     if obs_type not in OBS_TYPES:
         raise ValueError(f"obs_type must be one of {OBS_TYPES}, got {obs_type!r}")
     table = {
@@ -201,4 +212,6 @@ def make_observation(kind: str, obs_type: str, n_beams: int, grid_size: int):
         ("placement", "vector"): PlacementVectorObs,
         ("placement", "grid"): PlacementGridObs,
     }
+    if map_ranges:
+        return RobotVectorObs(n_beams, grid_size, map_ranges=True)
     return table[(kind, obs_type)](n_beams, grid_size)

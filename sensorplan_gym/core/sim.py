@@ -75,6 +75,9 @@ class BatchSim:
         self.scan_ang = np.zeros((N, B))
         self.has_scan = np.zeros(N, dtype=bool)
         self.segs = SegmentRows(N)  # walls, obstacles (and the target in Recognize)
+        self.static_segs = SegmentRows(N)  # walls and obstacles: the map
+        self.map_ranges = getattr(self, "map_ranges", False)
+        self.map_dist = np.zeros((N, B))
         self.region_segs = SegmentRows(N)
         self.regions = np.empty(N, dtype=object)
         self.spaces = np.empty(N, dtype=object)  # free space of the robot's centre
@@ -138,6 +141,7 @@ class BatchSim:
         self.worlds[i] = world
         r = world.batch_rows()
         self.segs.set_row(i, r["segs"])
+        self.static_segs.set_row(i, r["segs"])
         self.region_segs.set_row(i, r["region_segs"])
         self.regions[i] = world.region
         self.spaces[i] = world.robot_space
@@ -279,6 +283,11 @@ class BatchSim:
         dist, nrm, hit = cast_batch(x, y, ang, self._rows(self.segs, idx), self.reach[sel])
         if z is not None and self.noise > 0:
             dist = add_noise(dist, hit, z, self.noise, self.reach[sel])
+        if self.map_ranges:  # what the map predicts from the commanded pose
+            cx, cy = self.x[sel], self.y[sel]
+            mang = self.offsets[sel] + self.psi[sel][:, None]
+            rows = self._rows(self.static_segs, idx)
+            self.map_dist[sel] = cast_batch(cx, cy, mang, rows, self.reach[sel])[0]
         self.sx[sel], self.sy[sel], self.spsi[sel] = x, y, psi
         self.scan_dist[sel] = dist
         self.scan_normal[sel] = nrm

@@ -29,6 +29,11 @@ noise : float, default 0 -- std of Gaussian range noise (scene units).
 obs_type : ``"vector"`` (default) | ``"grid"`` (see :mod:`sensorplan_gym.core.observations`).
 grid_size : int, default 64 -- side of the grid observation.
 robot_radius : float, default 0 -- the robot is a disc of this radius (0: a point).
+action_type : ``"continuous"`` (default) | ``"discrete"`` (see :mod:`sensorplan_gym.core.actions`).
+map_ranges : bool, default False -- Navigate/Recognize vector observations also carry, per
+    beam, the range the static map predicts from the commanded pose (see
+    :mod:`sensorplan_gym.core.observations`): a reading that differs reveals the target.
+max_steps : int | None -- the time limit (default 200; Placement: 1).
 random_scene_kwargs : dict | None -- passed to ``random_scene`` when ``scene="random"``.
 render_mode : ``None`` | ``"rgb_array"`` | ``"human"``.
 
@@ -52,6 +57,7 @@ import gymnasium as gym
 import numpy as np
 import shapely
 
+from ..core.actions import make_actions
 from ..core.observations import make_observation
 from ..core.pool import FixedScene, shared_pool
 from ..core.rendering import HumanViewer, Renderer
@@ -59,7 +65,7 @@ from ..core.sensor import RangeSensor
 from ..core.sim import BLOCK, BatchSim
 from ..core.world import World, WorldConfig, get_world, load_scene
 
-__all__ = ["RobotBatch", "SensorPlanBatch", "SensorPlanEnv", "check_actions"]
+__all__ = ["RobotBatch", "SensorPlanBatch", "SensorPlanEnv"]
 
 Start = tuple[float, float, float]
 
@@ -100,22 +106,6 @@ def _check(world: World, rng: np.random.Generator, needs_start: bool):
     return start, _scene_problem(world, start, needs_start)
 
 
-def check_actions(actions: Any, shape: tuple[int, ...]) -> np.ndarray:
-    """Validate and clip a batch of actions: an array of ``shape`` (``(k, d)``); a wrong shape
-    or non-finite values raise ``ValueError``; values outside [-1, 1] are clipped."""
-    try:
-        a = np.asarray(actions, dtype=np.float64)
-    except (TypeError, ValueError) as e:
-        raise ValueError(
-            f"action must be a numeric array of shape {shape[1:]}, got {actions!r}"
-        ) from e
-    if a.shape != shape:
-        raise ValueError(f"action must have shape {shape[1:]}, got shape {a.shape[1:]}")
-    if not np.isfinite(a).all():
-        raise ValueError(f"action contains NaN or infinite values: {a.tolist()}")
-    return np.clip(a, -1.0, 1.0)
-
-
 class SensorPlanBatch(BatchSim):
     """A task over N sub-environments; subclasses define ``obs_kind``, ``action_dim`` and the
     hooks ``_reset_one`` (Python, per resetting sub-environment: draws from its generator),
@@ -124,6 +114,7 @@ class SensorPlanBatch(BatchSim):
     obs_kind = "robot"
     needs_start = True
     action_dim = 3
+    action_task = "robot"
     horizon = 200
 
     def __init__(
@@ -147,6 +138,9 @@ class SensorPlanBatch(BatchSim):
         scene_pool_size: int = 64,
         scene_pool_seed: int = 0,
         max_steps: int | None = None,
+        action_type: str = "continuous",
+        map_ranges: bool = False,
+        **action_kw: Any,
     ) -> None:
         for name, v in (
             ("eps_pos", eps_pos),
@@ -173,10 +167,23 @@ class SensorPlanBatch(BatchSim):
             robot_radius=float(robot_radius),
         ).validate()
         super().__init__(n, n_beams, noise, robot_radius)
+        unknown = set(action_kw) - {"placement_grid", "placement_aims"}
+        if unknown or (action_kw and self.action_task != "placement"):
+            bad = sorted(action_kw if not unknown else unknown)
+            raise TypeError(f"{self.task_name}: unexpected keyword argument(s) {bad}")
+        if not isinstance(map_ranges, bool):
+            raise ValueError(f"map_ranges must be True or False, got {map_ranges!r}")
+        if map_ranges and (obs_type != "vector" or self.obs_kind != "robot"):
+            raise ValueError("map_ranges=True needs obs_type='vector' in Navigate or Recognize")
+        self.map_ranges = map_ranges
         self.obs_type = obs_type
-        self.obs = make_observation(self.obs_kind, obs_type, self.n_beams, grid_size)
+        self.obs = make_observation(
+            self.obs_kind, obs_type, self.n_beams, grid_size, map_ranges=map_ranges
+        )
         self.single_observation_space = self.obs.space
-        self.single_action_space = gym.spaces.Box(-1.0, 1.0, (self.action_dim,), np.float32)
+        self.actions = make_actions(action_type, self.action_task, self.action_dim, **action_kw)
+        self.action_type = action_type
+        self.single_action_space = self.actions.space
         self.elapsed = np.zeros(self.n, dtype=np.int64)
         self.random = isinstance(scene, str) and scene == "random"
         check = functools.partial(_check, needs_start=self.needs_start)
@@ -452,7 +459,7 @@ class SensorPlanEnv(gym.Env):
         return obs, info
 
     def step(self, action):
-        a = check_actions(_as_batch(action), (1, *self.action_space.shape))
+        a = self.batch.actions.to_array(_as_batch(action), 1)
         reward, term, trunc, cols = self.batch.step_envs(a, self._ONE)
         obs = self.batch.observe(self._ONE)[0]
         if self.render_mode == "human":
@@ -485,8 +492,8 @@ class SensorPlanEnv(gym.Env):
 
 
 def _as_batch(action: Any) -> Any:
-    """One action as a batch of one (left as is when it is not numeric: the check says so)."""
+    """One action as a batch of one (left as is when it is not an array: the check says so)."""
     try:
-        return np.asarray(action, dtype=np.float64)[None]
+        return np.asarray(action)[None]
     except (TypeError, ValueError):
         return action

@@ -45,6 +45,7 @@ class PlacementBatch(SensorPlanBatch):
 
     obs_kind = "placement"
     needs_start = False
+    action_task = "placement"
     horizon = 1
 
     def __init__(self, n: int, scene="lab", *, shaping: float = 0.0, **kwargs) -> None:

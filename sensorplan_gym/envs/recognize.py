@@ -7,18 +7,27 @@ whose beams are occluded and reflected by the target like any wall, and ends the
 episode by declaring G or H.
 
 Observation
-    As Navigate-v0 (``vector``: ``8 + 3 * n_beams`` float32; ``grid``: 5 x S x S uint8).
-    The target's side and pose are never part of it: only the beams it reflects.
+    As Navigate-v0 (``vector``: ``8 + 3 * n_beams`` float32, ``8 + 4 * n_beams`` with
+    ``map_ranges=True``: the ranges the static map predicts, so that a reading that differs
+    shows the target; ``grid``: 5 x S x S uint8).  The target's side and pose are never part
+    of it: only the beams it reflects.
 Action
     ``Box(-1, 1, (4,), float32)`` = ``(forward, lateral, turn, decide)``; the first three
     drive as in Navigate-v0 (the target is an obstacle too).  ``decide`` in thirds:
-    ``< -1/3`` declares **G**, ``> 1/3`` declares **H**, otherwise continue.  A declaring
-    step still moves first, then the declaration ends the episode.  Out-of-range values
-    are clipped to [-1, 1]; NaN/inf or a wrong shape raise ``ValueError``.
+    ``< -1/3`` points at **G**, ``> 1/3`` at **H**, otherwise continue.  A label pointed at
+    on ``declare_hold`` consecutive steps (default 1) is declared: a declaring step still
+    moves first, then the declaration ends the episode.  ``declare_hold=3`` or more keeps
+    an exploring policy (whose ``decide`` crosses +-1/3 at random) from ending episodes by
+    accident: it has to mean it.  Out-of-range values are clipped to [-1, 1]; NaN/inf or a
+    wrong shape raise ``ValueError``.  ``action_type="discrete"``: ``Discrete(9)``, the
+    seven motions of :mod:`sensorplan_gym.core.actions` plus 7 = point at G, 8 = at H.
 Reward
     ``-step_cost`` (default 0.01) every step; ``+1`` for a right declaration, ``-1`` for a
     wrong one; the step that hits the time limit without a declaration gets ``-1`` (a
-    timeout counts as wrong).
+    timeout counts as wrong).  Optional potential-based shaping for training,
+    ``shaping * (d_before - d_after) / diameter`` with ``d`` the distance to the exact
+    recognizable region (a map quantity: it says nothing about where the target is);
+    ``shaping=0`` by default.
 Termination
     ``terminated`` on a declaration; ``truncated`` when ``max_steps`` steps have passed
     (default 200, also the registered ``max_episode_steps``); the timeout penalty is
@@ -53,9 +62,28 @@ class RecognizeBatch(RobotBatch):
 
     obs_kind = "robot"
     action_dim = 4
+    action_task = "recognize"
 
-    def __init__(self, n: int, scene="lab", *, step_cost: float = 0.01, **kwargs) -> None:
+    def __init__(
+        self,
+        n: int,
+        scene="lab",
+        *,
+        step_cost: float = 0.01,
+        shaping: float = 0.0,
+        declare_hold: int = 1,
+        **kwargs,
+    ) -> None:
+        if not isinstance(declare_hold, (int, np.integer)) or declare_hold < 1:
+            raise ValueError(f"declare_hold must be a positive integer, got {declare_hold!r}")
+        if not isinstance(shaping, (int, float)) or not math.isfinite(shaping):
+            raise ValueError(f"shaping must be a finite number, got {shaping!r}")
         self.step_cost = float(step_cost)
+        self.shaping = float(shaping)
+        self.declare_hold = int(declare_hold)
+        self.hold = np.zeros(n, dtype=np.int64)  # consecutive steps pointing at one label
+        self.pointing = np.zeros(n, dtype=np.int8)
+        self.dist = np.zeros(n)
         self.side = np.zeros(n, dtype=np.int8)  # _G or _H: where the hidden target is
         self.declared = np.zeros(n, dtype=np.int8)
         self.target_polys: list[np.ndarray | None] = [None] * n
@@ -95,7 +123,14 @@ class RecognizeBatch(RobotBatch):
     def _reset_one(self, i: int, options: dict) -> None:
         self._start_from_options(i, {})
         self.declared[i] = _NONE
+        self.hold[i] = 0
+        self.pointing[i] = _NONE
         self._place_target(i)
+
+    def _after_reset(self, idx: np.ndarray) -> None:
+        super()._after_reset(idx)
+        if self.shaping:
+            self.dist[idx] = self.query(idx)[3]
 
     def _extra_clearance(self, idx, x, y, mask) -> np.ndarray:
         out = np.full(len(idx), np.inf)
@@ -124,10 +159,20 @@ class RecognizeBatch(RobotBatch):
         self.elapsed[idx] += 1
         self.move(act, idx)
         d = act[:, 3]
-        dec = np.where(d < -1 / 3, _G, np.where(d > 1 / 3, _H, _NONE)).astype(np.int8)
+        want = np.where(d < -1 / 3, _G, np.where(d > 1 / 3, _H, _NONE)).astype(np.int8)
+        same = (want != _NONE) & (want == self.pointing[idx])
+        hold = np.where(same, self.hold[idx] + 1, (want != _NONE).astype(np.int64))
+        self.hold[idx], self.pointing[idx] = hold, want
+        dec = np.where(hold >= self.declare_hold, want, _NONE).astype(np.int8)
         self.declared[idx] = dec
         term = dec != _NONE
         reward = np.full(len(idx), -self.step_cost)
+        if self.shaping:
+            dist = self.query(idx)[3]
+            before = self.dist[idx]
+            ok = np.isfinite(dist) & np.isfinite(before)
+            reward += np.where(ok, self.shaping * (before - dist) / self.diameter[idx], 0.0)
+            self.dist[idx] = dist
         reward += np.where(term, np.where(dec == self.side[idx], 1.0, -1.0), 0.0)
         trunc = ~term & (self.elapsed[idx] >= self.max_steps)
         reward -= trunc  # a timeout counts as wrong

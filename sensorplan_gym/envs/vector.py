@@ -30,7 +30,7 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
 from ..core.rendering import HumanViewer, Renderer
-from .base import SensorPlanBatch, check_actions
+from .base import SensorPlanBatch
 from .navigate import NavigateBatch
 from .placement import PlacementBatch
 from .recognize import RecognizeBatch
@@ -127,7 +127,7 @@ class SensorPlanVectorEnv(VectorEnv):
     def step(self, actions) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict]:
         if not self._started:
             raise gym.error.ResetNeeded("call reset() before step()")
-        act = check_actions(actions, (self.num_envs, *self.single_action_space.shape))
+        act = self.batch.actions.to_array(actions, self.num_envs)
         n = self.num_envs
         rewards = np.zeros(n)
         terms = np.zeros(n, dtype=bool)

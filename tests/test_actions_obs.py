@@ -1,0 +1,145 @@
+"""Action types (continuous / discrete), map-predicted ranges, Recognize's declare hold and
+shaping, and the oracle under declare_hold."""
+
+from __future__ import annotations
+
+import warnings
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import sensorplan_gym  # noqa: F401
+from sensorplan_gym.core.actions import ROBOT_MOTIONS
+from sensorplan_gym.registration import ENV_IDS
+
+IDS = sorted(ENV_IDS)
+
+
+@pytest.mark.parametrize("env_id", IDS)
+def test_discrete_actions_pass_checkers(env_id):
+    from gymnasium.utils.env_checker import check_env
+
+    env = gym.make(env_id, action_type="discrete")
+    assert isinstance(env.action_space, gym.spaces.Discrete)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        check_env(env.unwrapped, skip_render_check=True)
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match="range"):
+        env.step(env.action_space.n)
+    with pytest.raises(ValueError, match="integer"):
+        env.step(0.5)
+
+
+def test_discrete_motions_are_the_table():
+    a = gym.make("sensorplan/Navigate-v0", action_type="discrete")
+    b = gym.make("sensorplan/Navigate-v0")
+    for k, (_, row) in enumerate(ROBOT_MOTIONS):
+        a.reset(seed=1)
+        b.reset(seed=1)
+        oa = a.step(k)[0]
+        ob = b.step(np.array(row, dtype=np.float32))[0]
+        assert np.array_equal(oa, ob)
+    p = gym.make(
+        "sensorplan/Placement-v0", action_type="discrete", placement_grid=4, placement_aims=2
+    )
+    assert p.action_space.n == 32
+    p.reset(seed=0)
+    info = p.step(0)[4]
+    w = p.unwrapped.world
+    x0 = w.lo[0] + (w.hi[0] - w.lo[0]) / 8  # first cell centre
+    assert info["pose"][0] == pytest.approx(x0) and info["pose"][2] == pytest.approx(-np.pi)
+    with pytest.raises(TypeError, match="placement_grid"):
+        gym.make("sensorplan/Navigate-v0", placement_grid=4)
+    with pytest.raises(ValueError, match="action_type"):
+        gym.make("sensorplan/Navigate-v0", action_type="mixed")
+
+
+def test_discrete_vector_env_equals_single():
+    v = gym.make_vec(
+        "sensorplan/Recognize-v0",
+        num_envs=2,
+        action_type="discrete",
+        vectorization_mode="vector_entry_point",
+    )
+    s = [gym.make("sensorplan/Recognize-v0", action_type="discrete") for _ in range(2)]
+    obs, _ = v.reset(seed=5)
+    for i, e in enumerate(s):
+        assert np.array_equal(obs[i], e.reset(seed=5 + i)[0])
+    rng = np.random.default_rng(0)
+    for _ in range(30):
+        a = rng.integers(0, 7, 2)
+        obs, r, *_ = v.step(a)
+        for i, e in enumerate(s):
+            o, ri, *_ = e.step(int(a[i]))
+            assert np.array_equal(o, obs[i]) and ri == r[i]
+
+
+def test_map_ranges_reveal_the_target():
+    env = gym.make("sensorplan/Recognize-v0", map_ranges=True, n_beams=64)
+    n = 64
+    assert env.observation_space.shape == (8 + 4 * n,)
+    env.reset(seed=0)
+    u = env.unwrapped
+    w = u.world
+    p = w.region.representative_point()  # a recognizing placement sees the target
+    u.pose = (p.x, p.y, 0.0)
+    u.batch.sense(np.array([0]))
+    obs = u.batch.observe(np.array([0]))[0]
+    read, pred = obs[8 : 8 + n], obs[8 + 3 * n :]
+    assert (read <= pred + 1e-6).all()  # the target only ever shortens a beam
+    assert (read < pred - 1e-4).any()
+    nav = gym.make("sensorplan/Navigate-v0", map_ranges=True)
+    o, _ = nav.reset(seed=0)
+    o = nav.step(nav.action_space.sample())[0]
+    assert np.allclose(o[8:24], o[56:72])  # no target: the map predicts every reading
+    with pytest.raises(ValueError, match="map_ranges"):
+        gym.make("sensorplan/Navigate-v0", map_ranges=True, obs_type="grid")
+
+
+def test_declare_hold_and_shaping():
+    env = gym.make("sensorplan/Recognize-v0", declare_hold=3)
+    env.reset(seed=0)
+    a = np.array([0, 0, 0, -1], dtype=np.float32)
+    z = np.zeros(4, dtype=np.float32)
+    assert not env.step(a)[2]
+    assert not env.step(z)[2]  # a pause starts the count again
+    assert not env.step(a)[2] and not env.step(a)[2]
+    _, r, term, _, info = env.step(a)
+    assert term and info["declared"] == "G"
+    with pytest.raises(ValueError, match="declare_hold"):
+        gym.make("sensorplan/Recognize-v0", declare_hold=0)
+    # shaping: potential-based, the shaped returns telescope to shaping * (d0 - dT) / D
+    sh = gym.make("sensorplan/Recognize-v0", shaping=3.0, max_steps=15)
+    base = gym.make("sensorplan/Recognize-v0", max_steps=15)
+    _, i0 = sh.reset(seed=2)
+    base.reset(seed=2)
+    total = 0.0
+    for _ in range(15):
+        act = np.array([1.0, 0.3, 0.1, 0.0], dtype=np.float32)
+        _, r1, *_, info = sh.step(act)
+        _, r2, *_ = base.step(act)
+        total += r1 - r2
+    D = sh.unwrapped.world.diameter
+    assert total == pytest.approx(3.0 * (i0["distance_to_region"] - info["distance_to_region"]) / D)
+    assert total != 0.0
+
+
+def test_oracle_with_declare_hold():
+    from agents.oracle import OraclePolicy
+
+    env = gym.make("sensorplan/Recognize-v0", declare_hold=3)
+    pol = OraclePolicy(env)
+    ok = 0
+    for seed in range(3):
+        obs, _ = env.reset(seed=seed)
+        pol.reset()
+        for _ in range(200):
+            obs, r, term, trunc, info = env.step(pol.predict(obs)[0])
+            if term or trunc:
+                break
+        ok += bool(info["is_success"])
+    assert ok == 3
+    with pytest.raises(TypeError, match="continuous"):
+        OraclePolicy(gym.make("sensorplan/Navigate-v0", action_type="discrete"))
