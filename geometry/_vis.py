@@ -288,8 +288,10 @@ def gaps_many(
         )
     )
     crit = np.concatenate(cols, axis=1)
-    sort = _visindex.sorted_gaps if _visindex.available() else _sorted_gaps
-    owner, lo, hi = sort(q, start, width, dom.vert, crit, tol, interior)
+    if _visindex.available():
+        owner, lo, hi = _visindex.sorted_gaps(q, start, width, dom.vert, crit, tol, interior, dom)
+    else:
+        owner, lo, hi = _sorted_gaps(q, start, width, dom.vert, crit, tol, interior)
     mid = 0.5 * (lo + hi)
     open_ = np.ones(len(mid), dtype=bool)
     for w in (w1, w2):

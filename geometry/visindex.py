@@ -369,38 +369,129 @@ def blocking(dom: Domain, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.nda
 
 
 @_njit
+def _dir_rel(dx, dy, st, wd, tol, interior, narrow, c0, s0, c1, s1):  # pragma: no cover
+    """Direction of (dx, dy) relative to ``st`` if it lies in ``(0, wd)``, else -1."""
+    if not interior and max(abs(dx), abs(dy)) <= tol:
+        return -1.0
+    if narrow:
+        # cheap pre-filter: clearly outside the sector (slack >> rounding)
+        slack = 1e-6 * (abs(dx) + abs(dy))
+        if c0 * dy - s0 * dx < -slack or dx * s1 - dy * c1 < -slack:
+            return -1.0
+    r = (math.atan2(dy, dx) - st) % (2.0 * math.pi)
+    if r >= wd or r <= 0.0:
+        return -1.0
+    return r
+
+
+@_njit
 def _gaps_kernel(
-    q, start, width, vert, crit, tol, interior, counts_only, off, lo_out, hi_out
+    q,
+    start,
+    width,
+    vert,
+    crit,
+    tol,
+    interior,
+    counts_only,
+    off,
+    lo_out,
+    hi_out,
+    gx0,
+    gy0,
+    h,
+    nx,
+    ny,
+    cstart,
+    items,
+    vcell,
+    n_base,
 ):  # pragma: no cover
     TWO_PI = 2.0 * math.pi
     nv = vert.shape[0]
     nk = crit.shape[1]
     buf = np.empty(nv + nk + 2)
+    reach = 8.0 * math.hypot(nx * h, ny * h)
     for i in range(q.shape[0]):
         qx, qy = q[i, 0], q[i, 1]
         st, wd = start[i], width[i]
         narrow = wd < 0.9 * math.pi
+        c0, s0, c1, s1 = 1.0, 0.0, 1.0, 0.0
         if narrow:
             c0, s0 = math.cos(st), math.sin(st)
             c1, s1 = math.cos(st + wd), math.sin(st + wd)
         m = 0
         buf[m] = 0.0
         m += 1
-        for v in range(nv):
-            dx = vert[v, 0] - qx
-            dy = vert[v, 1] - qy
-            if not interior and max(abs(dx), abs(dy)) <= tol:
-                continue
-            if narrow:
-                # cheap pre-filter: clearly outside the sector (slack >> rounding)
-                slack = 1e-6 * (abs(dx) + abs(dy))
-                if c0 * dy - s0 * dx < -slack or dx * s1 - dy * c1 < -slack:
+        if narrow and n_base > 0:
+            # the grid cells met by the triangle (q, q + reach d0, q + reach d1), which
+            # holds the part of the sector inside the grid (padded by one cell)
+            ax, ay = qx + reach * c0, qy + reach * s0
+            bx, by = qx + reach * c1, qy + reach * s1
+            iy0 = max(0, int(math.floor((min(qy, ay, by) - gy0) / h)) - 1)
+            iy1 = min(ny - 1, int(math.floor((max(qy, ay, by) - gy0) / h)) + 1)
+            for iy in range(iy0, iy1 + 1):
+                ya = gy0 + iy * h
+                yb = ya + h
+                xmin = math.inf
+                xmax = -math.inf
+                for e in range(3):
+                    if e == 0:
+                        px, py, rx, ry = qx, qy, ax, ay
+                    elif e == 1:
+                        px, py, rx, ry = ax, ay, bx, by
+                    else:
+                        px, py, rx, ry = bx, by, qx, qy
+                    if py == ry:
+                        if ya <= py <= yb:
+                            xmin = min(xmin, px, rx)
+                            xmax = max(xmax, px, rx)
+                        continue
+                    t0 = (ya - py) / (ry - py)
+                    t1 = (yb - py) / (ry - py)
+                    tlo = max(0.0, min(t0, t1))
+                    thi = min(1.0, max(t0, t1))
+                    if tlo <= thi:
+                        xa = px + tlo * (rx - px)
+                        xb = px + thi * (rx - px)
+                        xmin = min(xmin, xa, xb)
+                        xmax = max(xmax, xa, xb)
+                if xmin > xmax:
                     continue
-            r = (math.atan2(dy, dx) - st) % TWO_PI
-            if r >= wd or r <= 0.0:
-                continue
-            buf[m] = r
-            m += 1
+                ix0 = max(0, int(math.floor((xmin - gx0) / h)) - 1)
+                ix1 = min(nx - 1, int(math.floor((xmax - gx0) / h)) + 1)
+                for ix in range(ix0, ix1 + 1):
+                    c = iy * nx + ix
+                    for p in range(cstart[c], cstart[c + 1]):
+                        v = items[p]
+                        if vcell[v] != c:  # each vertex once: in its own cell
+                            continue
+                        r = _dir_rel(
+                            vert[v, 0] - qx,
+                            vert[v, 1] - qy,
+                            st,
+                            wd,
+                            tol,
+                            interior,
+                            narrow,
+                            c0,
+                            s0,
+                            c1,
+                            s1,
+                        )
+                        if r >= 0.0:
+                            buf[m] = r
+                            m += 1
+            v_from = n_base
+        else:
+            v_from = 0
+        for v in range(v_from, nv):
+            r = _dir_rel(
+                vert[v, 0] - qx, vert[v, 1] - qy, st, wd, tol, interior, narrow, c0, s0, c1, s1
+            )
+            if r >= 0.0:
+                buf[m] = r
+                m += 1
         for k in range(nk):
             a = crit[i, k]
             if math.isnan(a):
@@ -425,6 +516,13 @@ def _gaps_kernel(
             off[i + 1] = cnt
 
 
+def _vertex_cells(grid: SegmentGrid) -> np.ndarray:
+    """Cell of the start vertex of every segment of ``grid`` (same rule as the walk)."""
+    ix = np.clip(np.floor((grid.seg[:, 0] - grid.x0) / grid.h), 0, grid.nx - 1).astype(np.int64)
+    iy = np.clip(np.floor((grid.seg[:, 1] - grid.y0) / grid.h), 0, grid.ny - 1).astype(np.int64)
+    return iy * grid.nx + ix
+
+
 def sorted_gaps(
     q: np.ndarray,
     start: np.ndarray,
@@ -433,27 +531,42 @@ def sorted_gaps(
     crit: np.ndarray,
     tol: float,
     interior: bool,
+    dom: Domain | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The angular gaps of :func:`geometry._vis.gaps_many`, compiled: for each viewpoint
     ``q[i]`` the sorted directions to every vertex (those within ``tol`` of ``q[i]``
     dropped unless ``interior``) and the extra critical directions ``crit[i]`` (NaN
     ignored), relative to ``start[i]`` and restricted to ``(0, width[i])``; consecutive
     directions more than 1e-13 apart bound a gap.  Returns ``owner, lo, hi`` (flat, in
-    viewpoint order, radians).  A narrow sector first drops the vertices clearly
-    outside it by two cross products, so only nearby directions are sorted."""
+    viewpoint order, radians).
+
+    A narrow sector (below 0.9 pi) first drops the vertices clearly outside it by two
+    cross products; with ``dom`` (whose ``vert`` is ``vert``) it visits only the vertices
+    in the grid cells met by the sector, so its cost follows the sector, not the scene.
+    Either way the directions kept -- hence the gaps -- are exactly the full loop's."""
     q = np.ascontiguousarray(q, dtype=np.float64)
     n = len(q)
     start = np.ascontiguousarray(start, dtype=np.float64)
     width = np.ascontiguousarray(width, dtype=np.float64)
     vert = np.ascontiguousarray(vert, dtype=np.float64)
     crit = np.ascontiguousarray(crit, dtype=np.float64).reshape(n, -1)
+    if dom is not None:
+        grid, n_base = grid_for(dom)
+        vcell = getattr(grid, "_vcell", None)
+        if vcell is None:
+            vcell = _vertex_cells(grid)
+            object.__setattr__(grid, "_vcell", vcell)
+        g = (grid.x0, grid.y0, grid.h, grid.nx, grid.ny, grid.start, grid.items, vcell, n_base)
+    else:
+        z = np.zeros(1, dtype=np.int64)
+        g = (0.0, 0.0, 1.0, 1, 1, z, z, z, 0)
     off = np.zeros(n + 1, dtype=np.int64)
     empty = np.empty(0)
-    _gaps_kernel(q, start, width, vert, crit, tol, interior, True, off, empty, empty)
+    _gaps_kernel(q, start, width, vert, crit, tol, interior, True, off, empty, empty, *g)
     np.cumsum(off, out=off)
     lo = np.empty(off[-1])
     hi = np.empty(off[-1])
-    _gaps_kernel(q, start, width, vert, crit, tol, interior, False, off, lo, hi)
+    _gaps_kernel(q, start, width, vert, crit, tol, interior, False, off, lo, hi, *g)
     owner = np.repeat(np.arange(n), np.diff(off))
     return owner, lo, hi
 

@@ -193,9 +193,17 @@ def test_compiled_sorted_gaps_equal_numpy():
     for interior in (False, True):
         a = _vis._sorted_gaps(q, start, width, dom.vert, crit, tol, interior)
         b = visindex.sorted_gaps(q, start, width, dom.vert, crit, tol, interior)
+        c = visindex.sorted_gaps(q, start, width, dom.vert, crit, tol, interior, dom)
         assert len(a[0]) > 10 * n
-        for x, y in zip(a, b, strict=True):
-            assert np.array_equal(x, y)
+        for x, y, z in zip(a, b, c, strict=True):
+            assert np.array_equal(x, y) and np.array_equal(x, z)
+    # a domain with an added ring: its vertices outside the grid are looped over
+    ring = np.array([[0.0, 0.0], [0.3, 0.0], [0.3, 0.3]]) + q[-1]
+    dom2 = dom.with_ring(ring[::-1], 2)
+    a = _vis._sorted_gaps(q, start, width, dom2.vert, crit, tol, False)
+    c = visindex.sorted_gaps(q, start, width, dom2.vert, crit, tol, False, dom2)
+    for x, z in zip(a, c, strict=True):
+        assert np.array_equal(x, z)
 
 
 @pytest.mark.skipif(not visindex.available(), reason="numba not installed (fast extra)")
