@@ -264,9 +264,9 @@ def test_sees_matches_cgal(scene, model):
                 max_range=rng_max,
             ),
         )
-        for _ep in range(3):
+        for _ep in range(2):
             env.reset(seed=int(rng.integers(1 << 30)))
-            for t in range(0, env.move_steps + 1, 5):
+            for t in range(0, env.move_steps + 1, 7):
                 q = env.traj.at(t)
                 for _ in range(4):
                     x, y, _ = env._draw_pose(rng, [], avoid_a=False)

@@ -14,7 +14,7 @@ from sensorplan_gym.core.world import BUNDLED_SCENES
 
 @pytest.mark.parametrize("scene", BUNDLED_SCENES)
 def test_oracle_declares_right_with_one_and_two_watchers(scene):
-    rows = evaluate_watch([scene], [1, 2], episodes=4, seed=0)
+    rows = evaluate_watch([scene], [1, 2], episodes=3, seed=0)
     for r in rows:
         assert r["success_rate"] == 1.0, (scene, r["n_watchers"], r["per_episode"])
         assert r["team_visible_fraction"] > 0.3
