@@ -12,8 +12,10 @@ from .complete import complete_region
 from .partial import partial_region
 from .recognize import overlap_segments, recognizable_region
 from .scene import Scene, SceneError, SensorSpec
+from .sweep import QueryTimeout
 
 __all__ = [
+    "QueryTimeout",
     "Scene",
     "SceneError",
     "SensorSpec",

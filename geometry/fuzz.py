@@ -23,7 +23,8 @@ demands equality up to the output's rounding.
 * ``unsafe``: a sampled member of a complete region that an independent segment test
   finds blind to part of the target (points within 1e-6 D of the region's boundary are
   skipped);
-* ``translation``: the region of the scene translated by an exact offset, translated
+* ``translation``: the region of the scene translated by an exact offset (a multiple of a
+  power of two near the scene's size, 10 to 1e5 sizes away), translated
   back, differs from the original by more than 1e-9 D^2;
 * ``hang``: a query that took more than 10 s (scenes of at most 60 edges).
 
@@ -273,6 +274,12 @@ def _draft_scene(rng: np.random.Generator, max_edges: int) -> dict[str, Any] | N
     free = bpoly.difference(shapely.union_all(obs)) if obs else bpoly
     r = diam * rng.uniform(0.01, 0.05)
     target = _target(rng, r)
+    if rng.random() < 0.2:  # reference point on the outline or outside the target
+        if rng.random() < 0.5:
+            target = target - target[int(rng.integers(len(target)))]
+        else:
+            target = target + rng.uniform(-1.5 * r, 1.5 * r, 2)
+        dr.features.append("reference_off")
     size = r * rng.uniform(0.5, 3.0)
     pg = _place(rng, free, 1.2 * r + 1.5 * size)
     if pg is None:

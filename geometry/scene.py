@@ -4,9 +4,9 @@ Frames and units
 ----------------
 * World frame: the plane of ``bounds``; lengths in the scene's own (arbitrary) unit.
 * Target frame: ``target`` is given relative to its reference point, which is the origin
-  ``(0, 0)`` and must lie inside the target polygon.  A target *configuration*
-  ``q = (x, y, theta)`` places the reference point at ``(x, y)`` and rotates the target by
-  ``theta`` radians counter-clockwise about it (:meth:`Scene.target_at`).
+  ``(0, 0)``; it may lie inside the target polygon, on its outline or outside it.  A target
+  *configuration* ``q = (x, y, theta)`` places the reference point at ``(x, y)`` and rotates
+  the target by ``theta`` radians counter-clockwise about it (:meth:`Scene.target_at`).
 * Angles: radians everywhere in the Python API; only the JSON fields whose names end in
   ``_deg`` are degrees.  ``start[2]`` is in radians.
 
@@ -16,7 +16,7 @@ The JSON format (see issue 2)::
       "name": "lab",
       "bounds":    [[x, y], ...],          # simple polygon (walls), need not be convex
       "obstacles": [[[x, y], ...], ...],   # polygons; may touch or overlap (they are merged)
-      "target":    [[x, y], ...],          # target A in its own frame, (0, 0) inside A
+      "target":    [[x, y], ...],          # target A in its own frame (reference point (0, 0))
       "goal":      [[x, y], ...],          # G: a polygon, or one point [[x, y]]
       "failure":   [[x, y], ...],          # H: a polygon, or one point [[x, y]]
       "sensor":    {"fov_deg": 360, "max_range": null, "eps_pos": 0.0, "eps_aim_deg": 0.0,
@@ -350,7 +350,7 @@ class Scene:
         bounds: ``(N, 2)`` float64, the walls, counter-clockwise.
         obstacles: tuple of ``(Ni, 2)`` float64 arrays, each counter-clockwise.
         target: ``(M, 2)`` float64 target polygon in its own frame, counter-clockwise, the
-            reference point ``(0, 0)`` strictly inside.
+            reference point ``(0, 0)`` anywhere (inside, on the outline or outside).
         goal: ``(K, 2)`` float64 goal region G (CCW polygon); ``K == 1`` means a point.
         failure: ``(K, 2)`` float64 failure region H, same convention.
         sensor: the :class:`SensorSpec` (defaults if the JSON has no ``sensor``).
@@ -358,7 +358,7 @@ class Scene:
 
     Validation (raises :class:`SceneError`): every polygon is simple, has >= 3 vertices, no
     repeated consecutive vertices, positive area, finite numbers; obstacles lie inside the
-    bounds; the target's reference point is inside the target; G and H lie in the free space
+    bounds; when the target's reference point is inside the target, G and H lie in the free space
     and do not overlap; no obstacle or wall meets CH(A ⊕ G) or CH(A ⊕ H) at orientation 0
     (the paper's assumption, section 3.1.1); ``start`` lies in the free space.
     """
@@ -506,11 +506,13 @@ class Scene:
                 raise SceneError(
                     f"obstacles[{i}]: lies (partly) outside the bounds (walls), at {_fmt_pt(x, y)}"
                 )
-        tpoly = Polygon(self.target)
-        if not tpoly.contains(Point(0.0, 0.0)):
-            where = "on the boundary of" if tpoly.covers(Point(0.0, 0.0)) else "outside"
-            raise SceneError(f"target: reference point (0, 0) is {where} the target polygon")
-        for which in ("goal", "failure"):
+        # The reference point may lie anywhere (inside, on the outline, outside: an L-shaped
+        # robot framed at its inner corner, a footprint framed at its rear axle).  Inside,
+        # G and H are sets of points of the target and must lie in the free space; else
+        # only the target's swept hull CH(A ⊕ G) must be clear (checked below), which is
+        # all the paper's assumption asks.
+        ref_inside = Polygon(self.target).contains(Point(0.0, 0.0))
+        for which in ("goal", "failure") if ref_inside else ():
             g = self.region(which)
             v = self._violation(g)
             if v is not None:
@@ -542,11 +544,12 @@ class Scene:
             )
         if self.start is not None:
             p = Point(self.start[0], self.start[1])
-            v = self._violation(p)
+            v = self._violation(p if ref_inside else self.target_at(*self.start))
             if v is not None:
+                what = "" if ref_inside else " (the target placed there)"
                 raise SceneError(
-                    f"start: {_fmt_pt(self.start[0], self.start[1])} is not in the free space "
-                    f"(bounds minus obstacles): meets {v[0]}"
+                    f"start: {_fmt_pt(self.start[0], self.start[1])}{what} is not in the free "
+                    f"space (bounds minus obstacles): meets {v[0]}"
                 )
 
     # -- read-only-ness, equality, pickling ------------------------------------------------------

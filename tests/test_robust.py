@@ -379,3 +379,48 @@ def test_swept_timeout_and_progress():
         partial_region(s, target_in="goal", theta=0.0, progress=3)
     with pytest.raises(ValueError, match="target_in"):
         partial_region(s, target_at=(2, 1.5, 0), timeout=5)
+
+
+# -- reference point anywhere ---------------------------------------------------------------------
+
+#: An L-shaped robot; ``c`` is where the reference point goes in each variant.
+L_SHAPE = np.array([[0.0, 0.0], [0.6, 0.0], [0.6, 0.2], [0.2, 0.2], [0.2, 0.5], [0.0, 0.5]])
+
+
+@pytest.mark.parametrize(
+    "ref",
+    [(0.1, 0.1), (0.2, 0.2), (0.4, 0.4), (-0.3, 0.25)],
+    ids=["inside", "inner corner (on the outline)", "outside, in the notch", "outside, behind"],
+)
+def test_reference_point_anywhere(ref):
+    """The regions depend on where the target *is*, not on its reference point: a target
+    framed at ``ref`` with G/H at g + ref equals the same target framed inside."""
+    c = np.asarray(ref)
+    base_ref = np.array([0.1, 0.1])
+    d = {**ROOM, "goal": [[2.0, 1.5], [2.4, 1.5], [2.4, 1.9], [2.0, 1.9]], "failure": [[8, 6.0]]}
+
+    def framed(r: np.ndarray) -> Scene:
+        out = copy.deepcopy(d)
+        out["target"] = (L_SHAPE - r).tolist()
+        out["goal"] = (np.asarray(d["goal"]) + r).tolist()
+        out["failure"] = (np.asarray(d["failure"]) + r).tolist()
+        return Scene.from_dict(out)
+
+    s0, s1 = framed(base_ref), framed(c)
+    rot = np.array([[math.cos(0.3), -math.sin(0.3)], [math.sin(0.3), math.cos(0.3)]])
+    tiny = 1e-9 * s0.diameter**2
+    pairs = [
+        (complete_region(s0, target_in="goal", theta=0.0),
+         complete_region(s1, target_in="goal", theta=0.0)),
+        (partial_region(s0, target_at=(8.1, 6.1, 0.3)),
+         partial_region(s1, target_at=(*(np.array([8.1, 6.1]) + rot @ (c - base_ref)), 0.3))),
+        (partial_region(s0, target_in="goal", theta=0.0),
+         partial_region(s1, target_in="goal", theta=0.0)),
+    ]  # fmt: skip
+    for a, b in pairs:
+        assert a.area > 0 and shapely.symmetric_difference(a, b).area < 1e-6 * s0.diameter**2
+    # rotating about a different point sweeps a different area: only containment in the
+    # fixed-orientation region holds, and the any-orientation region is well defined
+    any1 = complete_region(s1, target_in="goal", theta=None)
+    assert shapely.difference(any1, pairs[0][1]).area < tiny
+    assert recognizable_region(s1).is_valid

@@ -387,12 +387,13 @@ def test_obstacle_outside_bounds(lab_dict):
 
 
 def test_target_reference_point(lab_dict):
-    with pytest.raises(
-        SceneError, match=r"target: reference point \(0, 0\) is outside the target polygon"
-    ):
-        build(lab_dict, target=[[1, 1], [2, 1], [2, 2]])
-    with pytest.raises(SceneError, match=r"target: reference point \(0, 0\) is on the boundary"):
-        build(lab_dict, target=[[0, 0], [1, 0], [0, 1]])
+    # issue 10: the reference point may lie outside the target or on its outline
+    s = build(lab_dict, target=[[1, 1], [2, 1], [2, 2]])
+    assert s.target_radius == pytest.approx(math.hypot(2, 2))
+    build(lab_dict, target=[[0, 0], [1, 0], [0, 1]])
+    # ... but the swept hull must still be clear
+    with pytest.raises(SceneError, match=r"goal: CH\(A ⊕ G\).*meets obstacles\[0\]"):
+        build(lab_dict, target=[[4, 4], [5, 4], [5, 5]])
 
 
 @pytest.mark.parametrize("which", ["goal", "failure"])
