@@ -54,17 +54,47 @@ def _gym_evaluation_matches_local():
 
 
 def _rllib_shared_policy_smoke(tmp_path):
-    from agents.rllib_train import RLlibWatchPolicy, load_config, train_rllib
+    """``sensorplan train --backend rllib --address ADDR`` attaches to the running Ray
+    instance (the existing-cluster path), trains 2 tiny iterations and checkpoints."""
+    import json
+    import subprocess
+    import sys
+
+    import yaml
+
+    from agents.rllib_train import RLlibWatchPolicy, load_config
     from agents.watch_oracle import run_watch_episodes
 
     cfg = load_config()
     cfg["env"].update(max_steps=30, move_steps=15)
     cfg["ppo"].update(train_batch_size_per_learner=120, minibatch_size=60, num_epochs=1)
     cfg["model"]["fcnet_hiddens"] = [16]
-    res = train_rllib(cfg, seed=0, iterations=2, out=tmp_path / "run", verbose=False)
-    assert len(res["progress"]) == 2
-    assert res["progress"][-1]["env_steps"] >= 240
-    assert (tmp_path / "run" / "config.yaml").is_file()
+    (tmp_path / "cfg.yaml").write_text(yaml.safe_dump(cfg))
+    address = ray.get_runtime_context().gcs_address
+    out = tmp_path / "run"
+    cmd = [
+        sys.executable,
+        "-m",
+        "agents.cli",
+        "train",
+        "--backend",
+        "rllib",
+        "--config",
+        str(tmp_path / "cfg.yaml"),
+        "--iterations",
+        "2",
+        "--out",
+        str(out),
+        "--address",
+        address,
+    ]
+    proc = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    progress = [json.loads(line) for line in (out / "progress.jsonl").read_text().splitlines()]
+    assert len(progress) == 2 and progress[-1]["env_steps"] >= 240
+    saved = yaml.safe_load((out / "config.yaml").read_text())
+    assert saved["address"] == address and saved["seed"] == 0
+    res = {"checkpoint": str(out / "checkpoint")}
     policy = RLlibWatchPolicy(res["checkpoint"])
     ep = run_watch_episodes(cfg["env"], policy, [5])
     assert ep["seed"] == [5] and 0.0 <= ep["visible"][0] <= 1.0
