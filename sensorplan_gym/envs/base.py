@@ -305,6 +305,8 @@ class RobotBatch(SensorPlanBatch):
         self._max_speed_cfg = None if max_speed is None else float(max_speed)
         self.max_turn = float(max_turn)
         self.collided = np.zeros(n, dtype=bool)
+        self.dist = np.zeros(n)  # distance to the region at the last step (shaping)
+        self.shaping = getattr(self, "shaping", 0.0)
         super().__init__(n, scene, **kwargs)
 
     def load_world(self, i: int, world: World, max_speed: float | None = None) -> None:
@@ -345,6 +347,15 @@ class RobotBatch(SensorPlanBatch):
 
     def _after_reset(self, idx: np.ndarray) -> None:
         self.sense(idx)
+
+    def shaping_reward(self, idx: np.ndarray, dist: np.ndarray) -> np.ndarray:
+        """Potential-based shaping ``shaping * (d_before - d_after) / diameter`` of
+        sub-environments ``idx`` (0 where a distance is infinite); ``dist`` becomes the
+        new ``d``."""
+        before = self.dist[idx]
+        self.dist[idx] = dist
+        ok = np.isfinite(dist) & np.isfinite(before)
+        return np.where(ok, self.shaping * (before - dist) / self.diameter[idx], 0.0)
 
     def move(self, act: np.ndarray, idx: np.ndarray) -> np.ndarray:
         """Drive sub-environments ``idx`` and read their sensors; returns ``collided``."""

@@ -61,7 +61,6 @@ class NavigateBatch(RobotBatch):
         self.step_cost = float(step_cost)
         self.success_bonus = float(success_bonus)
         self.shaping = float(shaping)
-        self.dist = np.zeros(n)
         self.success = np.zeros(n, dtype=bool)
         super().__init__(n, scene, **kwargs)
 
@@ -93,10 +92,9 @@ class NavigateBatch(RobotBatch):
         rec, _, _, dist = self.query(idx)
         reward = np.full(len(idx), -self.step_cost)
         if self.shaping:
-            before = self.dist[idx]
-            ok = np.isfinite(dist) & np.isfinite(before)
-            reward += np.where(ok, self.shaping * (before - dist) / self.diameter[idx], 0.0)
-        self.dist[idx] = dist
+            reward += self.shaping_reward(idx, dist)
+        else:
+            self.dist[idx] = dist
         reward += np.where(rec, self.success_bonus, 0.0)
         self.success[idx] = rec
         trunc = ~rec & (self.elapsed[idx] >= self.max_steps)

@@ -83,7 +83,6 @@ class RecognizeBatch(RobotBatch):
         self.declare_hold = int(declare_hold)
         self.hold = np.zeros(n, dtype=np.int64)  # consecutive steps pointing at one label
         self.pointing = np.zeros(n, dtype=np.int8)
-        self.dist = np.zeros(n)
         self.side = np.zeros(n, dtype=np.int8)  # _G or _H: where the hidden target is
         self.declared = np.zeros(n, dtype=np.int8)
         self.target_polys: list[np.ndarray | None] = [None] * n
@@ -168,11 +167,7 @@ class RecognizeBatch(RobotBatch):
         term = dec != _NONE
         reward = np.full(len(idx), -self.step_cost)
         if self.shaping:
-            dist = self.query(idx)[3]
-            before = self.dist[idx]
-            ok = np.isfinite(dist) & np.isfinite(before)
-            reward += np.where(ok, self.shaping * (before - dist) / self.diameter[idx], 0.0)
-            self.dist[idx] = dist
+            reward += self.shaping_reward(idx, self.query(idx)[3])
         reward += np.where(term, np.where(dec == self.side[idx], 1.0, -1.0), 0.0)
         trunc = ~term & (self.elapsed[idx] >= self.max_steps)
         reward -= trunc  # a timeout counts as wrong

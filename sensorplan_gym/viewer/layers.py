@@ -42,6 +42,8 @@ from geometry import (
     recognizable_region,
 )
 
+from ..core.world import MODELS, MOTIONS
+
 __all__ = [
     "LAYERS",
     "LAYER_TITLES",
@@ -52,9 +54,6 @@ __all__ = [
     "geom_to_multipolygon",
     "probe",
 ]
-
-MODELS = ("complete", "partial")
-MOTIONS = ("stationary", "translating", "rotating")
 
 #: Layer keys in drawing order (bottom first).
 LAYERS = ("partial_G", "partial_H", "complete_G", "complete_H", "recognizable")
