@@ -91,6 +91,16 @@ def build_config(cfg: dict[str, Any], seed: int):
     )
 
 
+def _num(v: Any) -> float | None:
+    """A metric as a float, ``None`` when RLlib reports none (missing or NaN: e.g. no
+    episode finished in that iteration); JSON has no NaN."""
+    try:
+        f = float(v)
+    except (TypeError, ValueError):
+        return None
+    return f if math.isfinite(f) else None
+
+
 def train_rllib(
     config: str | Path | dict | None = None,
     *,
@@ -147,18 +157,19 @@ def train_rllib(
                 er = r.get("env_runners", {})
                 row = {
                     "iteration": it,
-                    "env_steps": float(r.get("num_env_steps_sampled_lifetime", math.nan)),
-                    "episode_return_mean": float(er.get("episode_return_mean", math.nan)),
-                    "episodes": int(er.get("num_episodes", 0)),
+                    "env_steps": _num(r.get("num_env_steps_sampled_lifetime")),
+                    "episode_return_mean": _num(er.get("episode_return_mean")),
+                    "episodes": _num(er.get("num_episodes")),
                     "wall_s": round(time.perf_counter() - t0, 2),
                 }
                 progress.append(row)
                 f.write(json.dumps(row) + "\n")
                 f.flush()
                 if verbose:
+                    ret = row["episode_return_mean"]
                     print(
-                        f"iter {it:3d}  env steps {row['env_steps']:8.0f}  "
-                        f"return (all watchers) {row['episode_return_mean']:7.3f}  "
+                        f"iter {it:3d}  env steps {row['env_steps'] or 0:8.0f}  "
+                        f"return (all watchers) {'-' if ret is None else f'{ret:7.3f}'}  "
                         f"{row['wall_s']:7.1f} s",
                         flush=True,
                     )
