@@ -204,6 +204,9 @@ def run(
 def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--max-edges", type=int, default=max(EDGES))
+    ap.add_argument(
+        "--edges", type=int, nargs="+", default=None, help="scene sizes (default: 100 .. 8000)"
+    )
     ap.add_argument("--reps", type=int, default=5)
     ap.add_argument(
         "--budget", type=float, default=20.0, help="seconds per query and scene (fewer reps)"
@@ -214,13 +217,18 @@ def main(argv: list[str] | None = None) -> None:
     )
     ap.add_argument("--out", type=Path, default=RESULTS)
     args = ap.parse_args(argv)
-    edges = tuple(n for n in EDGES if n <= args.max_edges)
+    edges = tuple(n for n in (args.edges or EDGES) if n <= args.max_edges)
     table = run(edges, args.reps, args.budget, office=not args.no_office, brute_max=args.brute_max)
     print(table)
     args.out.parent.mkdir(parents=True, exist_ok=True)
     cmd = "python -m benchmarks.scaling" + (
         f" --max-edges {args.max_edges}" if args.max_edges != max(EDGES) else ""
     )
+    if args.edges:
+        cmd += " --edges " + " ".join(map(str, args.edges))
+    if args.no_office:
+        cmd += " --no-office"
+    cmd += f" --reps {args.reps}"
     args.out.write_text(f"# Scaling of the region queries\n\n`{cmd}`\n\n{table}", encoding="utf-8")
 
 
