@@ -16,6 +16,7 @@ import numpy as np
 import shapely
 from shapely import affinity
 
+from ._shapes import polygonal
 from ._vis import Domain, domain_from_geometry
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -321,24 +322,4 @@ def _diag(g: shapely.Geometry) -> float:
     return float(np.hypot(x1 - x0, y1 - y0))
 
 
-def _polygonal(g: shapely.Geometry) -> shapely.Geometry:
-    """Keep the areal parts of a boolean result, dropping debris: points, lines and
-    slivers of float noise (parts whose area is below 1e-10 of their squared
-    perimeter, e.g. a 1e-16-wide strip along an obstacle edge).  An answer with
-    nothing left is an empty Polygon."""
-    if g.is_empty:
-        return shapely.Polygon()
-    parts = shapely.get_parts(g)
-    parts = parts[np.isin(shapely.get_type_id(parts), (3, 6))]
-    if len(parts) and parts[0].geom_type == "MultiPolygon":
-        parts = shapely.get_parts(parts)
-    if len(parts):
-        parts = parts[shapely.area(parts) > 1e-10 * shapely.length(parts) ** 2]
-    if len(parts) == 0:
-        return shapely.Polygon()
-    if len(parts) == 1:
-        return parts[0]
-    return shapely.multipolygons(parts)
-
-
-polygonal = _polygonal
+_polygonal = polygonal  # the old private name (kept for callers outside the package)

@@ -32,6 +32,8 @@ import numpy as np
 import shapely
 import shapely.errors
 
+from ._shapes import areal
+
 __all__ = ["Frame", "IDENTITY", "frame_params", "world_messages", "to_world_point"]
 
 #: (offset_x, offset_y, scale) of the frame whose coordinates are being formatted
@@ -100,23 +102,13 @@ class Frame:
             fixed = shapely.make_valid(w, method="structure", keep_collapsed=False)
         except shapely.errors.GEOSException:  # pragma: no cover - GEOS corner cases
             fixed = shapely.buffer(w, 0.0)
-        return _areal(fixed)
+        return areal(fixed)
 
     def to_world_pts(self, p: np.ndarray) -> np.ndarray:
         return np.asarray(p, dtype=float) * self.scale + np.array([self.ox, self.oy])
 
 
 IDENTITY = Frame(0.0, 0.0, 1.0)
-
-
-def _areal(g: shapely.Geometry) -> shapely.Geometry:
-    """The polygonal parts of ``g`` as one Polygon/MultiPolygon (empty Polygon if none)."""
-    parts = shapely.get_parts(g)
-    parts = parts[np.isin(shapely.get_type_id(parts), (3, 6))]
-    if len(parts) == 0:
-        return shapely.Polygon()
-    u = shapely.union_all(parts)
-    return u if u.geom_type in ("Polygon", "MultiPolygon") else _areal(u)
 
 
 def frame_params(pts: np.ndarray) -> Frame:

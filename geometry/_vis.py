@@ -23,6 +23,7 @@ import numpy as np
 import shapely
 
 from . import visindex as _visindex
+from ._shapes import cross
 
 TAU = 2.0 * np.pi
 
@@ -179,8 +180,7 @@ class Gaps:
         return self.hi - self.lo
 
 
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+_cross = cross  # the package's one cross product (geometry._shapes)
 
 
 def gaps_from(

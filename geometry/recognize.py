@@ -42,8 +42,10 @@ from ._common import (
     target_spec,
 )
 from ._frame import world_messages
+from ._shapes import ccw_ring
 from .complete import complete_region
-from .partial import ROTATING_PARTIAL, _ccw_ring, _swept_region, swept_tol, weak_visibility
+from .partial import ROTATING_PARTIAL, _swept_region, swept_tol
+from .weak import weak_visibility
 
 if TYPE_CHECKING:  # pragma: no cover
     from .scene import Scene
@@ -178,7 +180,7 @@ def _swept_recognizable(
 ) -> shapely.Geometry:
     """Paper 5.2: the non-overlap part A'(q) of the target swept through G and
     through H; the two partial regions intersected."""
-    target = _ccw_ring(scene.target_at(0.0, 0.0, theta))
+    target = ccw_ring(scene.target_at(0.0, 0.0, theta))
     n_g, n_h = (
         len(shapely.get_coordinates(scene.region(w).boundary)) - 1 for w in ("goal", "failure")
     )
@@ -266,7 +268,7 @@ def _overlap_segments(scene: Scene, theta: float) -> list[shapely.LineString]:
 
 
 def _ccw(poly: shapely.Polygon) -> np.ndarray:
-    return np.asarray(shapely.orient_polygons(poly, exterior_cw=False).exterior.coords)[:-1, :2]
+    return ccw_ring(poly)
 
 
 def _cuts(

@@ -54,6 +54,7 @@ from shapely.geometry import MultiPolygon, Point, Polygon
 from shapely.geometry.base import BaseGeometry
 
 from ._frame import IDENTITY, Frame, frame_params, to_world_point, world_messages
+from ._shapes import areal
 
 __all__ = ["SceneError", "SensorSpec", "Scene", "TOL_REL", "PAPER_ASSUMPTION"]
 
@@ -132,20 +133,9 @@ def _signed_area(pts: np.ndarray) -> float:
 
 
 def _polygonal(g: BaseGeometry) -> Polygon | MultiPolygon:
-    """Keep only the areal part of a shapely result; empty -> ``Polygon()``."""
-    if g.is_empty:
-        return Polygon()
-    if isinstance(g, (Polygon, MultiPolygon)):
-        return g
-    polys: list[Polygon] = []
-    for part in getattr(g, "geoms", []):
-        if isinstance(part, Polygon) and not part.is_empty:
-            polys.append(part)
-        elif isinstance(part, MultiPolygon):
-            polys.extend(part.geoms)
-    if not polys:
-        return Polygon()
-    return polys[0] if len(polys) == 1 else MultiPolygon(polys)
+    """Keep only the areal part of a shapely result; empty -> ``Polygon()``
+    (:func:`geometry._shapes.areal`: no float-noise sliver is dropped here)."""
+    return areal(g)
 
 
 def _witness(g: BaseGeometry, fallback: BaseGeometry) -> tuple[float, float]:

@@ -55,7 +55,11 @@ from shapely import affinity
 
 from . import visindex as _visindex
 from ._common import polygonal
+from ._shapes import cross as _cross
 from ._vis import TAU, Domain, RayEscapeError, gaps_many
+from .weak import ENV as _ENV
+from .weak import WANTED as _WANTED
+from .weak import weak_visibility
 
 __all__ = ["QueryTimeout", "Sweeper", "star_center", "swept_shadows"]
 
@@ -67,14 +71,6 @@ class QueryTimeout(TimeoutError):
 
 class _Expired(Exception):
     """Internal: the sweeper's deadline passed (turned into :class:`QueryTimeout`)."""
-
-
-#: Segment tags inside visibility domains built here.
-_ENV, _WANTED, _UNWANTED = 0, 1, 2
-
-
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
 
 
 def _meet(a0: np.ndarray, a1: np.ndarray, b0: np.ndarray, b1: np.ndarray) -> np.ndarray:
@@ -205,7 +201,6 @@ class Sweeper:
     def shadow(self, q: np.ndarray) -> tuple[shapely.Geometry, np.ndarray, np.ndarray]:
         """Exact shadow S(q) (free space minus target minus the partial region),
         with the anchor table used to label its edges."""
-        from .partial import weak_visibility
 
         ring, wanted, ids = self.outline(q)
         area = shapely.Polygon(self.ring0 + q)
@@ -529,7 +524,6 @@ class Sweeper:
     def _eroded_shadow(self, qa: np.ndarray, qb: np.ndarray) -> shapely.Geometry | None:
         """Shadow of the part of A common to all A_q, q in [qa, qb] (it contains
         every S(q) there); None when that part is empty."""
-        from .partial import weak_visibility
 
         aa = shapely.Polygon(self.ring0 + qa)
         ab = shapely.Polygon(self.ring0 + qb)

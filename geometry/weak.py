@@ -1,0 +1,154 @@
+"""Weak visibility of a target outline: the placements that see some wanted piece of
+it (paper 3.2.1, with the aim uncertainty of section 4), as a union of exact visibility
+triangles anchored at the ends of wanted pieces and at reflex vertices of the free space.
+The algorithm and its proof: :mod:`geometry.partial` and docs/DESIGN.md.
+
+Imports run one way: ``_vis -> weak -> sweep -> partial -> recognize``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import shapely
+
+from ._vis import TAU, Domain, Gaps, clean_polygon, gaps_many
+
+__all__ = ["ENV", "UNWANTED", "WANTED", "weak_visibility"]
+
+#: Segment tags inside the visibility domain.
+ENV, WANTED, UNWANTED = 0, 1, 2
+
+
+def weak_visibility(
+    env: Domain, ring: np.ndarray, wanted: np.ndarray, eps_aim: float = 0.0
+) -> shapely.Geometry:
+    """Placements that see some wanted piece of a target boundary.
+
+    Parameters
+    ----------
+    env : the free space as a visibility domain (without the target).
+    ring : (m, 2) target boundary, clockwise (it becomes a hole of the domain
+        and occludes); pieces to be seen must start and end at ring vertices
+        (insert the cut points first).
+    wanted : (m,) bool, True where segment ``ring[i] -> ring[i+1]`` is wanted.
+    eps_aim : drop anchor fans narrower than this (radians).
+
+    Returns
+    -------
+    Union of the visibility triangles (shapely geometry, world frame), not yet
+    clipped against the target itself.
+    """
+    dom = env.with_ring(ring, UNWANTED, np.where(wanted, WANTED, UNWANTED))
+    fans: list[shapely.Geometry] = []
+    # 1. anchors on the target: endpoints of wanted pieces, seen from the front
+    #    of a wanted edge at that vertex
+    edge = np.roll(ring, -1, axis=0) - ring
+    inc = np.stack([wanted, np.roll(wanted, 1)], axis=1)  # outgoing, incoming edge wanted
+    anchors = np.flatnonzero(inc.any(axis=1))
+    if len(anchors):
+        e_out, e_in = edge[anchors], np.roll(edge, 1, axis=0)[anchors]
+        dirs = np.stack([e_out, e_in], axis=1)  # (k, 2, 2)
+        ang = np.arctan2(dirs[..., 1], dirs[..., 0])
+        extra = np.concatenate([ang + np.pi, ang], axis=1)
+        for gi, i in zip(gaps_many(dom, ring[anchors], extra=extra), anchors, strict=False):
+            mid = 0.5 * (gi.lo + gi.hi)
+            d = np.stack([np.cos(mid), np.sin(mid)], axis=1)
+            front = np.zeros(len(mid), dtype=bool)
+            for e, use in ((edge[i], wanted[i]), (edge[i - 1], wanted[i - 1])):
+                if use:
+                    front |= e[0] * d[:, 1] - e[1] * d[:, 0] > 0
+            fans += _fans(gi, front & (gi.seg >= 0), dom, eps_aim)
+    n_direct = len(fans)
+    # 2. grazing anchors: reflex vertices v of the free space around the target;
+    #    first the directions in which v sees a wanted piece ...
+    v = dom.vert[dom.reflex]
+    if len(v):
+        rel = np.arctan2(ring[None, :, 1] - v[:, None, 1], ring[None, :, 0] - v[:, None, 0])
+        centre = ring.mean(axis=0)
+        base = np.arctan2(centre[1] - v[:, 1], centre[0] - v[:, 0])
+        rel = (rel - base[:, None] + np.pi) % TAU - np.pi
+        on_target = np.abs(ring[None, :, :] - v[:, None, :]).max(axis=2) <= 1e-12 * dom.scale
+        lo = np.where(on_target, np.inf, rel).min(axis=1)
+        hi = np.where(on_target, -np.inf, rel).max(axis=1)
+        ok = hi - lo > 1e-12
+        v, sectors = v[ok], np.stack([base[ok] + lo[ok], hi[ok] - lo[ok]], axis=1)
+        g, off = gaps_many(dom, v, sectors=sectors, flat=True)
+        sees = (g.seg >= 0) & (dom.seg_tag[np.maximum(g.seg, 0)] == WANTED)
+        back_q, back_sec = [], []
+        for k in np.unique(np.searchsorted(off, np.flatnonzero(sees), side="right") - 1):
+            gk = g.part(off[k], off[k + 1])
+            for run in _runs(gk, sees[off[k] : off[k + 1]]):
+                back_q.append(v[k])
+                back_sec.append((gk.lo[run[0]] + np.pi, _width(gk, run)))
+        # ... then the placements on the opposite side of v
+        if back_q:
+            backs = gaps_many(dom, np.asarray(back_q), sectors=np.asarray(back_sec))
+            for gb in backs:
+                fans += _fans(gb, gb.seg >= 0, dom, eps_aim)
+    if not fans:
+        return shapely.Polygon()
+    return _union(fans, n_first=n_direct)
+
+
+def _union(polys: list[shapely.Geometry], n_first: int) -> shapely.Geometry:
+    """Union of polygons; the later ones are first tested (vectorised) against the
+    union of the first ``n_first`` and dropped when already covered by it."""
+    first = shapely.union_all(polys[:n_first]) if n_first else shapely.Polygon()
+    rest = np.asarray(polys[n_first:], dtype=object)
+    if len(rest) and not first.is_empty:
+        shapely.prepare(first)
+        rest = rest[~shapely.covers(first, rest)]
+    if len(rest) == 0:
+        return first
+    return shapely.union_all(np.concatenate([[first], rest]))
+
+
+def _runs(g: Gaps, mask: np.ndarray) -> list[np.ndarray]:
+    """Maximal runs of adjacent gaps where ``mask`` holds, as index arrays in
+    angular order (a run may wrap through angle 0 when the gaps close a circle)."""
+    idx = np.flatnonzero(mask)
+    if len(idx) == 0:
+        return []
+    adjacent = np.abs(g.lo[idx[1:]] - g.hi[idx[:-1]]) <= 1e-12
+    parts = np.split(idx, np.flatnonzero(~adjacent) + 1)
+    closed = abs(g.hi[-1] - g.lo[0] - TAU) <= 1e-12
+    if len(parts) > 1 and closed and mask[0] and mask[-1]:
+        parts[0] = np.concatenate([parts.pop(), parts[0]])
+    return parts
+
+
+def _width(g: Gaps, run: np.ndarray) -> float:
+    return float((g.hi[run[-1]] - g.lo[run[0]]) % TAU or TAU)
+
+
+def _fans(g: Gaps, mask: np.ndarray, dom: Domain, eps_aim: float) -> list[shapely.Geometry]:
+    """Visibility polygons anchored at ``g.q``: runs of adjacent gaps in ``mask``
+    whose far side lies on one connected stretch of one polygon's boundary, as
+    shapely Polygons; with ``eps_aim > 0`` those whose apex angle is below
+    ``eps_aim`` are dropped (with ``eps_aim == 0`` runs are not split)."""
+    ring_of = np.where(g.seg >= 0, dom.seg_ring[np.maximum(g.seg, 0)], -1)
+    out: list[shapely.Geometry] = []
+    for run in _runs(g, mask):
+        if eps_aim > 0:
+            # split where the far side jumps to another polygon or another
+            # stretch of boundary (a depth discontinuity)
+            r = ring_of[run]
+            jump = np.abs(g.p0[run[1:]] - g.p1[run[:-1]]).max(axis=1) > 1e-9 * dom.scale
+            pieces = np.split(run, np.flatnonzero((r[1:] != r[:-1]) | jump) + 1)
+        else:
+            pieces = [run]
+        for piece in pieces:
+            if eps_aim > 0 and _width(g, piece) < eps_aim:
+                continue
+            pts = np.empty((2 * len(piece) + 1, 2))
+            pts[0] = g.q
+            pts[1::2] = g.p0[piece]
+            pts[2::2] = g.p1[piece]
+            # adjacent gaps ending on the same segment continue one straight edge: keep
+            # only the ends of such runs (fewer vertices for the union, same polygon)
+            same = g.seg[piece[1:]] == g.seg[piece[:-1]]
+            keep = np.ones(len(pts), dtype=bool)
+            keep[2:-1:2] = ~same
+            keep[3::2] = ~same
+            out.append(clean_polygon(pts[keep], 1e-10 * dom.scale))
+    return out
