@@ -31,10 +31,11 @@ def test_compiled_equals_numpy(shape, shared):
     ang = rng.uniform(-np.pi, np.pi, (n, b))
     ang[:, 0] = 0.0
     mr = rng.uniform(2, 20, n)
-    a = kernels.cast(ox, oy, np.cos(ang), np.sin(ang), *seg, mr)
-    c = kernels.cast_numpy(ox, oy, np.cos(ang), np.sin(ang), *seg, mr)
-    assert all(np.array_equal(x, y) for x, y in zip(a, c, strict=True))
-    assert a[1].any() and not a[1].all()  # both hits and misses were compared
+    for cull in (False, True):
+        a = kernels.cast(ox, oy, np.cos(ang), np.sin(ang), *seg, mr, cull)
+        c = kernels.cast_numpy(ox, oy, np.cos(ang), np.sin(ang), *seg, mr, cull)
+        assert all(np.array_equal(x, y) for x, y in zip(a, c, strict=True))
+        assert a[1].any() and not a[1].all()  # both hits and misses were compared
     d = rng.normal(0, 10, (2, n))
     d[:, -1] = 0.0  # no motion
     skin = np.full(n, 1e-7)
@@ -54,3 +55,28 @@ def test_seg_distance_compiled_equals_numpy():
         a = kernels.seg_distance(px, py, x0, y0, ex, ey)
         b = kernels.seg_distance_numpy(px, py, x0, y0, ex, ey)
         assert np.array_equal(a, b) and np.isfinite(a).all()
+
+
+@pytest.mark.parametrize("scene", ["lab", "edr", "corridor", "warehouse"])
+def test_culling_changes_no_reading(scene):
+    """World edges point into the free space: skipping the edges that face away from a free
+    origin gives exactly the full cast, on every bundled scene (with the target in it)."""
+    import gymnasium as gym
+    from shapely import Polygon, contains_xy
+
+    from sensorplan_gym.core.sensor import cast_batch
+
+    env = gym.make("sensorplan/Recognize-v0", scene=scene, n_beams=90)
+    env.reset(seed=1)
+    b = env.unwrapped.batch
+    w = b.worlds[0]
+    rng = np.random.default_rng(0)
+    pts = rng.uniform(w.lo, w.hi, (4000, 2))
+    free = w.robot_space.difference(Polygon(b.target_polys[0]))  # the target is not free
+    pts = pts[contains_xy(free, pts[:, 0], pts[:, 1])][:300]
+    rows = b._rows(b.segs, np.zeros(len(pts), dtype=np.intp))
+    ang = rng.uniform(-np.pi, np.pi, (len(pts), 90))
+    full = cast_batch(pts[:, 0], pts[:, 1], ang, rows, w.reach)
+    culled = cast_batch(pts[:, 0], pts[:, 1], ang, rows, w.reach, cull=True)
+    assert all(np.array_equal(x, y) for x, y in zip(full, culled, strict=True))
+    assert full[2].all()  # closed rooms: every beam hits something

@@ -43,14 +43,16 @@ __all__ = [
 _ERR = {"divide": "ignore", "invalid": "ignore", "over": "ignore"}
 
 
-def cast_numpy(ox, oy, dx, dy, x0, y0, ex, ey, nx, ny, max_range):
+def cast_numpy(ox, oy, dx, dy, x0, y0, ex, ey, nx, ny, max_range, cull=False):
     """First hits of rays ``o + t d`` on segments ``a + u e``.
 
     ``ox, oy``: ``(N,)``; ``dx, dy``: ``(N, B)`` unit directions; ``x0, y0, ex, ey, nx, ny``:
     ``(N, M)`` segment starts, edge vectors and unit normals (or ``(1, M)``, shared);
     ``max_range``: ``(N,)``.  Returns ``dist (N, B)`` (clipped at ``max_range``), ``hit``
     (bool) and the hit segment's normal turned to face the origin, ``(N, B)`` x and y
-    (zero where nothing was hit)."""
+    (zero where nothing was hit).  ``cull=True``: skip the segments whose normal points away
+    from the origin (:func:`_front`) -- exact when every normal points into the free space
+    and the origins are free points."""
     ax = x0 - ox[:, None]  # (N, M): a - o
     ay = y0 - oy[:, None]
     tnum = (ax * ey - ay * ex)[:, None, :]  # cross(a - o, e)
@@ -62,6 +64,8 @@ def cast_numpy(ox, oy, dx, dy, x0, y0, ex, ey, nx, ny, max_range):
     ok = u >= 0.0
     ok &= u <= 1.0
     ok &= t >= 0.0  # NaN (parallel, collinear, padding) fails every test
+    if cull:
+        ok &= _front(ox, oy, x0, y0, nx, ny)[:, None, :]
     np.copyto(t, np.inf, where=~ok)
     idx = t.argmin(axis=2)
     dist = np.take_along_axis(t, idx[:, :, None], 2)[:, :, 0]
@@ -74,6 +78,13 @@ def cast_numpy(ox, oy, dx, dy, x0, y0, ex, ey, nx, ny, max_range):
     side = -(gx * ax[rows, idx] + gy * ay[rows, idx])
     sgn = np.sign(side) * hit
     return dist, hit, gx * sgn, gy * sgn
+
+
+def _front(ox, oy, x0, y0, nx, ny) -> np.ndarray:
+    """``(N, M)``: the origin lies strictly on the side of segment ``s`` its normal points to.
+    With normals pointing into the free space, a ray from a free point first meets the
+    boundary at such a segment, so the others can be skipped without changing any answer."""
+    return nx * (ox[:, None] - x0) + ny * (oy[:, None] - y0) > 0.0
 
 
 def point_sweep_numpy(px, py, dx, dy, x0, y0, ex, ey, nx, ny, skin):
@@ -143,18 +154,25 @@ if HAVE_NUMBA:  # pragma: no cover - exercised when numba is installed
             out[k] = np.sqrt(best)
 
     @numba.njit(cache=True, nogil=True)
-    def _cast_nb(ox, oy, dx, dy, x0, y0, ex, ey, nx, ny, max_range, dist, hit, gx, gy):
+    def _cast_nb(ox, oy, dx, dy, x0, y0, ex, ey, nx, ny, max_range, cull, dist, hit, gx, gy):
         n, b = dx.shape
         m = x0.shape[1]
         shared = x0.shape[0] == 1
+        front = np.empty(m, dtype=np.intp)
         for k in range(n):
             r = 0 if shared else k
+            nf = 0
+            for s in range(m):  # the segments whose free side faces the origin
+                if not cull or nx[r, s] * (ox[k] - x0[r, s]) + ny[r, s] * (oy[k] - y0[r, s]) > 0.0:
+                    front[nf] = s
+                    nf += 1
             for j in range(b):
                 best = np.inf
                 bi = 0
                 ddx = dx[k, j]
                 ddy = dy[k, j]
-                for s in range(m):
+                for f in range(nf):
+                    s = front[f]
                     ax = x0[r, s] - ox[k]
                     ay = y0[r, s] - oy[k]
                     den = ddx * ey[r, s] - ddy * ex[r, s]
@@ -204,16 +222,16 @@ if HAVE_NUMBA:  # pragma: no cover - exercised when numba is installed
                 out[k] = 1.0
 
 
-def cast(ox, oy, dx, dy, x0, y0, ex, ey, nx, ny, max_range):
+def cast(ox, oy, dx, dy, x0, y0, ex, ey, nx, ny, max_range, cull=False):
     """:func:`cast_numpy`, compiled when numba is available (same answers)."""
     if not HAVE_NUMBA:
-        return cast_numpy(ox, oy, dx, dy, x0, y0, ex, ey, nx, ny, max_range)
+        return cast_numpy(ox, oy, dx, dy, x0, y0, ex, ey, nx, ny, max_range, cull)
     n, b = dx.shape
     dist = np.empty((n, b))
     hit = np.empty((n, b), dtype=np.bool_)
     gx = np.empty((n, b))
     gy = np.empty((n, b))
-    _cast_nb(ox, oy, dx, dy, x0, y0, ex, ey, nx, ny, max_range, dist, hit, gx, gy)
+    _cast_nb(ox, oy, dx, dy, x0, y0, ex, ey, nx, ny, max_range, cull, dist, hit, gx, gy)
     return dist, hit, gx, gy
 
 

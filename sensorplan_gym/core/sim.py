@@ -280,14 +280,17 @@ class BatchSim:
             x, y, psi = x.copy(), y.copy(), psi.copy()
             x[st], y[st], psi[st] = sx, sy, sp
         ang = self.offsets[sel] + psi[:, None]
-        dist, nrm, hit = cast_batch(x, y, ang, self._rows(self.segs, idx), self.reach[sel])
+        # world edges are oriented into the free space and the target's outwards: cull
+        dist, nrm, hit = cast_batch(
+            x, y, ang, self._rows(self.segs, idx), self.reach[sel], cull=True
+        )
         if z is not None and self.noise > 0:
             dist = add_noise(dist, hit, z, self.noise, self.reach[sel])
         if self.map_ranges:  # what the map predicts from the commanded pose
             cx, cy = self.x[sel], self.y[sel]
             mang = self.offsets[sel] + self.psi[sel][:, None]
             rows = self._rows(self.static_segs, idx)
-            self.map_dist[sel] = cast_batch(cx, cy, mang, rows, self.reach[sel])[0]
+            self.map_dist[sel] = cast_batch(cx, cy, mang, rows, self.reach[sel], cull=True)[0]
         self.sx[sel], self.sy[sel], self.spsi[sel] = x, y, psi
         self.scan_dist[sel] = dist
         self.scan_normal[sel] = nrm

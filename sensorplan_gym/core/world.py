@@ -158,7 +158,9 @@ class World:
         self.region_segs = boundary_segments(region)
 
         self.free_space = scene.free_space
-        self.segs = boundary_segments(self.free_space)
+        # exteriors counter-clockwise, holes clockwise: every edge's left normal points into
+        # the free space (the range sensor skips edges whose free side faces away)
+        self.segs = boundary_segments(shapely.orient_polygons(self.free_space))
         self.seg_normals = segment_normals(self.segs)
         self.seg_set = Segments(self.segs, self.seg_normals)
         self.region_rows = Segments(self.region_segs)

@@ -111,7 +111,7 @@ class RecognizeBatch(RobotBatch):
         self.target_polys[i] = poly
         if w.theta is None:
             segs = np.concatenate([poly, np.roll(poly, -1, axis=0)], axis=1)
-            rows = pad_segments(segs, segment_normals(segs), len(segs))
+            rows = pad_segments(segs, _outward(segs), len(segs))
         else:  # a translate of the target's own edges
             rows = k["rows"].copy()
             rows[0] += q[0]
@@ -183,6 +183,13 @@ class RecognizeBatch(RobotBatch):
         return st
 
 
+def _outward(segs: np.ndarray) -> np.ndarray:
+    """Unit normals of a polygon's edges ``(T, 4)`` pointing out of it (into free space)."""
+    n = segment_normals(segs)
+    area2 = float(np.sum(segs[:, 0] * segs[:, 3] - segs[:, 2] * segs[:, 1]))
+    return -n if area2 > 0 else n  # counter-clockwise: left normals point inwards
+
+
 def _hidden_target(w) -> dict:
     """Per-world constants for placing the target (cached on the world): its edges at the
     origin as ``(6, T)`` rows, the static rows, and the must-see hulls as polygons."""
@@ -194,7 +201,7 @@ def _hidden_target(w) -> dict:
         for h in hulls:
             shapely.prepare(h)
         k = w._cache["hidden_target"] = {
-            "rows": pad_segments(segs, segment_normals(segs), len(segs)),
+            "rows": pad_segments(segs, _outward(segs), len(segs)),
             "static": w.batch_rows()["segs"],
             "hulls": hulls,
         }
