@@ -171,6 +171,15 @@ def _first_hits_kernel(
             if t < best_t:
                 best_t = t
                 best = extra_base + k
+        if not (x0 <= qx <= x0 + nx * h and y0 <= qy <= y0 + ny * h):
+            # a viewpoint off the grid (no caller makes one): test every segment
+            for j in range(seg.shape[0]):
+                t = _hit(qx, qy, dx, dy, seg[j, 0], seg[j, 1], seg[j, 2], seg[j, 3], tmin)
+                if t < best_t or (t == best_t and j < best):
+                    best_t = t
+                    best = j
+            out[i] = best
+            continue
         ix = int(math.floor((qx - x0) / h))
         iy = int(math.floor((qy - y0) / h))
         ix = max(0, min(nx - 1, ix))
@@ -423,7 +432,8 @@ def _gaps_kernel(
         m = 0
         buf[m] = 0.0
         m += 1
-        if narrow and n_base > 0:
+        on_grid = gx0 <= qx <= gx0 + nx * h and gy0 <= qy <= gy0 + ny * h
+        if narrow and n_base > 0 and on_grid:
             # the grid cells met by the triangle (q, q + reach d0, q + reach d1), which
             # holds the part of the sector inside the grid (padded by one cell)
             ax, ay = qx + reach * c0, qy + reach * s0

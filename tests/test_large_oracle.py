@@ -252,3 +252,32 @@ def test_compiled_sweep_windows_equal_numpy(monkeypatch):
             assert np.array_equal(x, y)
         n_ranges += len(fast[0])
     assert n_ranges > 50
+
+
+@pytest.mark.skipif(not visindex.available(), reason="numba not installed (fast extra)")
+def test_viewpoints_off_the_grid():
+    """Viewpoints outside the grid's box (no query makes them; the kernels test every
+    segment / every vertex there) give the brute force's answers."""
+    dom = scene_domain(Scene.from_dict(scene_with_edges(400, 1)))
+    grid, _ = visindex.grid_for(dom)
+    lo = np.array([grid.x0, grid.y0])
+    hi = lo + [grid.nx * grid.h, grid.ny * grid.h]
+    mid = 0.5 * (lo + hi)
+    q = np.array([lo - 5.0, [hi[0] + 3.0, mid[1]], [mid[0], lo[1] - 2.0]])
+    rng = np.random.default_rng(2)
+    q = np.repeat(q, 100, axis=0)
+    aim = mid + rng.uniform(-0.2, 0.2, (len(q), 2)) * (hi - lo)
+    phi = np.arctan2(aim[:, 1] - q[:, 1], aim[:, 0] - q[:, 0])
+    a = visindex.first_hits(dom, q, phi)
+    assert (a >= 0).all()
+    assert np.array_equal(a, _vis._first_hits(dom, q, phi, brute=True))
+    vq = q[::100]
+    st = np.arctan2(mid[1] - vq[:, 1], mid[0] - vq[:, 0]) - 0.2
+    w = np.full(len(vq), 0.4)
+    crit = np.full((len(vq), 1), np.nan)
+    tol = 1e-12 * dom.scale
+    x = visindex.sorted_gaps(vq, st, w, dom.vert, crit, tol, True, dom)
+    y = _vis._sorted_gaps(vq, st, w, dom.vert, crit, tol, True)
+    assert len(x[0]) > 30
+    for u, v in zip(x, y, strict=True):
+        assert np.array_equal(u, v)
