@@ -45,6 +45,7 @@ from __future__ import annotations
 import json
 import math
 import re
+import warnings
 from collections.abc import Iterable, Mapping, Sequence
 from os import PathLike
 from pathlib import Path
@@ -165,6 +166,8 @@ def _region_coords(g: Any, where: str) -> list[list[float]]:
         if g.is_empty:
             raise FormatError(f"{where}: empty point")
         return [[float(g.x), float(g.y)]]
+    if not isinstance(g, Polygon):
+        raise FormatError(f"{where}: expected a Polygon or a Point, got {g.geom_type}")
     return _ring(_check_polygon(g, where, holes=False).exterior.coords)
 
 
@@ -238,7 +241,9 @@ def scene_from_geojson(
         if gj is None:
             raise FormatError(f"{where}: missing geometry")
         try:
-            g = shape(gj)
+            with warnings.catch_warnings():  # NaN coordinates: reported below
+                warnings.simplefilter("ignore", RuntimeWarning)
+                g = shape(gj)
         except Exception as e:  # shapely raises several types for malformed input
             raise FormatError(f"{where}: malformed geometry: {e}") from None
         if g.has_z:

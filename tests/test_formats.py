@@ -188,6 +188,18 @@ def test_simple_pieces_exact_union():
             r"features\[2\] \(role 'target'\): a polygon with 1 hole\(s\) is not allowed",
         ),
         (
+            lambda fc: fc["features"][3].update(
+                geometry={"type": "MultiPoint", "coordinates": [[1, 1], [2, 2]]}
+            ),
+            r"features\[3\] \(role 'goal'\): expected a Polygon or a Point, got MultiPoint",
+        ),
+        (
+            lambda fc: fc["features"][1]["geometry"].update(
+                coordinates=[[[5, 5], [7, 5], [7, float("nan")], [5, 5]]]
+            ),
+            r"features\[1\] \(role 'obstacle'\): non-finite coordinate",
+        ),
+        (
             lambda fc: fc.update(type="Feature"),
             r"expected a GeoJSON FeatureCollection, got 'Feature'",
         ),
