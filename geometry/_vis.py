@@ -418,8 +418,18 @@ def _ray_line(q: np.ndarray, phi: np.ndarray, s: np.ndarray) -> np.ndarray:
     a = s[:, :2] - q
     e = s[:, 2:] - s[:, :2]
     den = _cross(d, e)
-    t = _cross(a, e) / den
-    return q + d * t[:, None]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = _cross(a, e) / den
+    out = q + d * t[:, None]
+    bad = ~np.isfinite(out).all(axis=1)
+    if bad.any():
+        # a bounding ray along the segment's own line (the viewpoint on that line, within
+        # rounding): the boundary point on that ray is the segment's nearer end
+        a0, a1 = s[bad, :2], s[bad, 2:]
+        qb = q[bad] if q.ndim == 2 and len(q) == len(s) else np.broadcast_to(q, a0.shape)
+        near0 = np.hypot(*(a0 - qb).T) <= np.hypot(*(a1 - qb).T)
+        out[bad] = np.where(near0[:, None], a0, a1)
+    return out
 
 
 def polygon_from_gaps(g: Gaps) -> shapely.Geometry:
