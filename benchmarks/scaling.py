@@ -16,7 +16,8 @@ structures already built):
 and, **in the same run on the same scenes**, the anchor: one CGAL visibility polygon
 (pyvispoly's triangular expansion, ``compute_visibility_polygon``) at each of 20 free
 points, median per point.  The table gives each median, its ratio to the anchor, and
-the log-log growth slope (least squares over 100 .. 1,600 edges).  Up to ``--brute-max``
+the log-log growth slope (least squares over 100 .. 1,600 edges).  It also times
+``gym.make`` and ``reset`` of Navigate-v0 on the office floor.  Up to ``--brute-max``
 edges (default 1,600) the complete and partial queries are also timed with the grid index
 switched off (the numpy brute-force ray casts, the code path without numba), so the
 speed-up is read off one run.  Written to
@@ -198,7 +199,31 @@ def run(
         *("| " + " | ".join(r) + " |" for r in rows),
         "| growth slope 100 -> 1,600 | | | " + " | ".join(slopes) + " | | |",
     ]
+    if office and OFFICE.exists():
+        t_make, t_reset = _env_times()
+        lines += [
+            "",
+            f"Navigate-v0 on the office floor (complete model): gym.make {1e3 * t_make:,.0f} ms "
+            f"(the world is computed once), reset median {1e3 * t_reset:.2f} ms over 20 seeds.",
+        ]
     return "\n".join(lines) + "\n"
+
+
+def _env_times() -> tuple[float, float]:
+    """Seconds of ``gym.make`` and the median ``reset`` of Navigate-v0 on the office floor."""
+    import gymnasium as gym
+
+    t0 = time.perf_counter()
+    env = gym.make("sensorplan_gym:sensorplan/Navigate-v0", scene=str(OFFICE))
+    t_make = time.perf_counter() - t0
+    env.reset(seed=0)
+    resets = []
+    for seed in range(1, 21):
+        t0 = time.perf_counter()
+        env.reset(seed=seed)
+        resets.append(time.perf_counter() - t0)
+    env.close()
+    return t_make, statistics.median(resets)
 
 
 def main(argv: list[str] | None = None) -> None:
