@@ -13,7 +13,11 @@ segment is hit first) is the same -- the index only skips segments that cannot b
 earlier; nothing is sampled or approximated.
 
 The same grid answers "which segments pass within ``tol`` of this point" for the
-local-obstruction test of viewpoints on the boundary.
+local-obstruction test of viewpoints on the boundary, and lets the compiled angular sort
+of :func:`sorted_gaps` visit only the vertices in the cells a narrow sector meets.
+:func:`window_ranges` is the compiled twin of the window clipping of the swept point
+test (:meth:`geometry.sweep.Sweeper._windows`).  Every compiled step is tested against
+the numpy code bit for bit (``tests/test_large_oracle.py``).
 
 numba is an optional dependency (the ``fast`` extra).  Without it :func:`available`
 is False and :mod:`geometry._vis` keeps its vectorised brute-force code.
@@ -42,10 +46,16 @@ except ImportError:  # pragma: no cover
 if TYPE_CHECKING:  # pragma: no cover
     from ._vis import Domain
 
-__all__ = ["SegmentGrid", "available", "first_hits", "grid_for", "near_pairs"]
-
-#: Domains with fewer segments than this use the brute-force code (no gain below it).
-MIN_SEGMENTS = 0
+__all__ = [
+    "SegmentGrid",
+    "available",
+    "blocking",
+    "first_hits",
+    "grid_for",
+    "near_pairs",
+    "sorted_gaps",
+    "window_ranges",
+]
 
 #: Registration margin of a segment in the cells, relative to the domain's scale: larger
 #: than every tolerance of the hit test (s in [-1e-12, 1 + 1e-12], boundary tol 1e-12).
@@ -80,6 +90,8 @@ class SegmentGrid:
 
     @staticmethod
     def build(seg: np.ndarray, scale: float, cells_per_segment: float = 1.0) -> SegmentGrid:
+        """Grid of about ``cells_per_segment * len(seg)`` square cells over the segments'
+        bounding box (at most 4096 per side); ``scale`` sets the margin (scene units)."""
         seg = np.ascontiguousarray(seg, dtype=np.float64)
         margin = MARGIN_REL * max(scale, 1e-300)
         lo = np.minimum(seg[:, :2], seg[:, 2:]).min(axis=0) - 4 * margin
@@ -98,7 +110,18 @@ class SegmentGrid:
         return SegmentGrid(seg, float(lo[0]), float(lo[1]), h, nx, ny, start, items, margin)
 
 
-def _register(seg, x0, y0, h, nx, ny, margin, fill):
+def _register(
+    seg: np.ndarray,
+    x0: float,
+    y0: float,
+    h: float,
+    nx: int,
+    ny: int,
+    margin: float,
+    fill: tuple[np.ndarray, np.ndarray] | None,
+) -> np.ndarray | None:
+    """Count (``fill`` None: returns the per-cell counts) or write (``fill = (next free
+    position per cell, items)``) the segments meeting each cell grown by ``margin``."""
     if fill is None:
         counts = np.zeros(nx * ny, dtype=np.int64)
         _register_kernel(seg, x0, y0, h, nx, ny, margin, counts, counts, counts, False)
