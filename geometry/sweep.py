@@ -512,6 +512,7 @@ class Sweeper:
             else:
                 known = shapely.union(frame(a)[0], frame(b)[0])
                 parts = shapely.get_parts(upper)
+                parts = parts[~shapely.is_empty(parts)]  # an empty shadow is no new component
                 new = bool((~shapely.intersects(parts, known)).any()) if len(parts) else False
             if new:
                 m = 0.5 * (a + b)
