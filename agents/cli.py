@@ -138,6 +138,30 @@ def build_parser() -> argparse.ArgumentParser:
     )
     e.add_argument("--address", default=None, help="ray: an existing Ray cluster's address")
 
+    bm = sub.add_parser(
+        "benchmark",
+        help="evaluate policies on the train / test / bundled-scene splits (agents.benchmark)",
+        description="Every policy on procedural train and held-out test scenes and on every "
+        "bundled scene, with the difficulty knob reported; writes benchmark.json/.csv.",
+    )
+    bm.add_argument("--env", required=True, help=ENV_CHOICES_HELP)
+    bm.add_argument(
+        "--policies", nargs="+", required=True, help="'oracle', 'random' and/or paths to model zips"
+    )
+    bm.add_argument("--episodes", type=int, default=100)
+    bm.add_argument("--seed", type=int, default=0)
+    bm.add_argument(
+        "--difficulty",
+        type=float,
+        default=None,
+        help="min_start_distance of the procedural splits, in scene diameters (default 0.4)",
+    )
+    bm.add_argument(
+        "--splits", nargs="+", default=None, help="train, test, ood, ood:<scene> (default: all)"
+    )
+    bm.add_argument("--env-kwargs", type=_json_dict, default=None)
+    bm.add_argument("--out", default=None, help="output folder (default runs/benchmark_<env>)")
+
     sub.add_parser(
         "demo", help="the paper's surveillance scenario end to end (agents.demo)", add_help=False
     )
@@ -220,6 +244,20 @@ def main(argv: list[str] | None = None) -> int:
                 threads=args.threads,
                 progress_bar=False if args.no_progress else None,
                 tensorboard=False if args.no_tensorboard else None,
+            )
+            return 0
+        if args.command == "benchmark":
+            from .benchmark import DEFAULT_DIFFICULTY, benchmark
+
+            benchmark(
+                args.env,
+                args.policies,
+                episodes=args.episodes,
+                seed=args.seed,
+                difficulty=DEFAULT_DIFFICULTY if args.difficulty is None else args.difficulty,
+                split_names=args.splits,
+                env_kwargs=args.env_kwargs,
+                out=args.out,
             )
             return 0
         if args.command == "evaluate":

@@ -16,6 +16,9 @@ scene : str | path | dict | geometry.Scene, default ``"lab"``
     from the start, or that contain the start are re-drawn when the pool is built).
 scene_pool_size : int, default 64 -- scenes in the ``"random"`` pool.
 scene_pool_seed : int, default 0 -- the pool's seed (disjoint seeds: disjoint splits).
+min_start_distance : float, default 0 -- a difficulty knob for ``scene="random"``: pool
+    scenes whose start lies closer than this fraction of the scene diameter to the
+    recognizable region are re-drawn (Navigate, Recognize).
 model : ``"complete"`` | ``"partial"`` -- the visibility model of the recognizable region.
 motion : ``"stationary"`` | ``"translating"`` | ``"rotating"`` (see
     :mod:`sensorplan_gym.core.world`).  Unsupported combinations raise
@@ -98,7 +101,21 @@ def _scene_problem(world: World, start: Start, needs_start: bool) -> str | None:
     return None
 
 
-def _check(world: World, rng: np.random.Generator, needs_start: bool):
+def _check(
+    world: World, rng: np.random.Generator, needs_start: bool, min_start_distance: float = 0.0
+):
+    """``(start, problem)`` of a world: its start pose and why it cannot host an episode
+    (``None`` if it can).  With ``min_start_distance`` > 0 the start is drawn uniformly among
+    the free positions at least that fraction of the diameter away from the region."""
+    if needs_start and min_start_distance > 0:
+        thr = min_start_distance * world.diameter
+        for _ in range(500):
+            x = float(rng.uniform(world.lo[0], world.hi[0]))
+            y = float(rng.uniform(world.lo[1], world.hi[1]))
+            if world.in_free_space(x, y) and world.distance_to_region(x, y) >= thr:
+                start = (x, y, float(rng.uniform(-math.pi, math.pi)))
+                return start, _scene_problem(world, start, needs_start)
+        return None, f"no free start {min_start_distance} diameters from the region"
     try:
         start = _start_pose(world, rng, needs_start)
     except ValueError as e:
@@ -135,6 +152,7 @@ class SensorPlanBatch(BatchSim):
         robot_radius: float = 0.0,
         random_scene_kwargs: dict | None = None,
         max_scene_tries: int = 25,
+        min_start_distance: float = 0.0,
         scene_pool_size: int = 64,
         scene_pool_seed: int = 0,
         max_steps: int | None = None,
@@ -186,12 +204,16 @@ class SensorPlanBatch(BatchSim):
         self.single_action_space = self.actions.space
         self.elapsed = np.zeros(self.n, dtype=np.int64)
         self.random = isinstance(scene, str) and scene == "random"
+        if not isinstance(min_start_distance, (int, float)) or not 0 <= min_start_distance < 1:
+            raise ValueError(f"min_start_distance must be in [0, 1), got {min_start_distance!r}")
+        self.min_start_distance = float(min_start_distance)
         check = functools.partial(_check, needs_start=self.needs_start)
         if self.random:
+            check = functools.partial(check, min_start_distance=self.min_start_distance)
             self.source = shared_pool(
                 self.cfg,
                 check,
-                "start" if self.needs_start else "nostart",
+                f"start>={self.min_start_distance}" if self.needs_start else "nostart",
                 size=scene_pool_size,
                 seed=scene_pool_seed,
                 scene_kwargs=dict(random_scene_kwargs or {}),
