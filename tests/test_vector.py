@@ -183,3 +183,49 @@ def test_random_scene_pool_deterministic_and_shared():
     assert mine.isdisjoint({id(w) for w in other.unwrapped.batch.worlds})
     with pytest.raises(ValueError, match="scene_pool_size"):
         _vec("sensorplan/Navigate-v0", 2, scene="random", scene_pool_size=0)
+
+
+def test_batched_queries_match_each_world_in_a_mixed_pool():
+    """Rows of different worlds (hulls of different sizes, a partial field of view): the
+    batched recognizability test equals each world's own test at the same poses."""
+    venv = _vec("sensorplan/Navigate-v0", 8, scene="random", scene_pool_size=8, fov_deg=120)
+    venv.reset(seed=0)
+    b = venv.unwrapped.batch
+    for _ in range(3):  # reload rows with other worlds
+        venv.reset(options={"reset_mask": np.arange(8) % 2 == 0})
+    assert len({id(w) for w in b.worlds}) > 2
+    assert len({w.batch_rows()["hulls"].shape[1] for w in b.worlds}) > 1
+    rng = np.random.default_rng(1)
+    idx = np.arange(8)
+    agree = hits = 0
+    for _ in range(60):
+        for i, w in enumerate(b.worlds):
+            p = w.region.representative_point() if rng.random() < 0.5 else None
+            b.x[i] = p.x if p else rng.uniform(w.lo[0], w.hi[0])
+            b.y[i] = p.y if p else rng.uniform(w.lo[1], w.hi[1])
+            b.psi[i] = rng.uniform(-np.pi, np.pi)
+        rec = b.query(idx)[0]
+        for i, w in enumerate(b.worlds):
+            agree += rec[i] == w.recognizing(b.x[i], b.y[i], b.psi[i])
+            hits += rec[i]
+    assert agree == 60 * 8 and hits > 0
+
+
+def test_rows_survive_a_larger_world():
+    """Loading a world with more hull vertices enlarges the padded arrays without touching
+    the other rows (each keeps its own hulls, padded by repeating its last vertex)."""
+    from sensorplan_gym.core.sim import BatchSim
+    from sensorplan_gym.core.world import WorldConfig, get_world, load_scene
+
+    small = get_world(load_scene("corridor"), WorldConfig(fov=2.0))
+    big = get_world(load_scene("lab"), WorldConfig(fov=2.0))
+    k_small = small.batch_rows()["hulls"].shape[1]
+    assert big.batch_rows()["hulls"].shape[1] > k_small
+    b = BatchSim(2, 8, 0.0, 0.0)
+    b.load_world(0, small)
+    b.load_world(1, small)
+    b.load_world(1, big)
+    h = b.hulls[0]
+    assert np.array_equal(h[:, :k_small], small.batch_rows()["hulls"])
+    assert (h[:, k_small:] == h[:, k_small - 1 : k_small]).all()
+    assert np.array_equal(b.hulls[1], big.batch_rows()["hulls"])

@@ -126,12 +126,15 @@ class BatchSim:
         return self._U[idx, p], self._Z[idx, p]
 
     # ---- worlds -----------------------------------------------------------------------
-    def _grow(self, name: str, shape: tuple[int, ...]) -> np.ndarray:
+    def _grow(self, name: str, shape: tuple[int, ...], edge: bool = False) -> np.ndarray:
+        """The per-row array ``name``, enlarged (rows kept) to hold ``shape`` per row; the new
+        cells are zero, or (``edge``) copies of each row's last cell along every axis."""
         a = getattr(self, name)
-        if any(s > t for s, t in zip(shape, a.shape[1:], strict=True)):
-            new = np.zeros((self.n, *np.maximum(shape, a.shape[1:])))
-            setattr(self, name, new)
-            a = new
+        want = tuple(int(v) for v in np.maximum(shape, a.shape[1:]))
+        if want != a.shape[1:]:
+            pad = [(0, 0)] + [(0, w - h) for w, h in zip(want, a.shape[1:], strict=True)]
+            a = np.pad(a, pad, mode="edge" if edge else "constant")
+            setattr(self, name, a)
         return a
 
     def load_world(self, i: int, world: World, max_speed: float | None = None) -> None:
@@ -146,7 +149,7 @@ class BatchSim:
         self.regions[i] = world.region
         self.spaces[i] = world.robot_space
         k = r["hulls"].shape[1]
-        hulls = self._grow("hulls", (2, k, 2))
+        hulls = self._grow("hulls", (2, k, 2), edge=True)
         hulls[i, :, :k] = r["hulls"]
         hulls[i, :, k:] = r["hulls"][:, -1:]
         self.centers[i] = r["centers"]
