@@ -545,8 +545,9 @@ def _gaps_kernel(
                     lo_out[base + cnt] = st + srt[p]
                     hi_out[base + cnt] = st + srt[p + 1]
                 cnt += 1
-        if counts_only:
-            off[i + 1] = cnt
+        # counting pass: the count; filling pass: the running offset (so a single filling
+        # pass over a buffer of the worst-case size lays the viewpoints out one after another)
+        off[i + 1] = cnt if counts_only else base + cnt
 
 
 def _vertex_cells(grid: SegmentGrid) -> np.ndarray:
@@ -593,15 +594,37 @@ def sorted_gaps(
     else:
         z = np.zeros(1, dtype=np.int64)
         g = (0.0, 0.0, 1.0, 1, 1, z, z, z, 0)
-    off = np.zeros(n + 1, dtype=np.int64)
-    empty = np.empty(0)
-    _gaps_kernel(q, start, width, vert, crit, tol, interior, True, off, empty, empty, *g)
-    np.cumsum(off, out=off)
-    lo = np.empty(off[-1])
-    hi = np.empty(off[-1])
-    _gaps_kernel(q, start, width, vert, crit, tol, interior, False, off, lo, hi, *g)
-    owner = np.repeat(np.arange(n), np.diff(off))
-    return owner, lo, hi
+    # one filling pass per block of viewpoints into a buffer of the worst-case size
+    # (every direction a gap boundary), about 2**20 gaps per block
+    cap = len(vert) + crit.shape[1] + 1
+    block = max(1, (1 << 20) // cap)
+    los, his, counts = [], [], []
+    for b0 in range(0, n, block):
+        b1 = min(n, b0 + block)
+        off = np.zeros(b1 - b0 + 1, dtype=np.int64)
+        lo = np.empty((b1 - b0) * cap)
+        hi = np.empty((b1 - b0) * cap)
+        _gaps_kernel(
+            q[b0:b1],
+            start[b0:b1],
+            width[b0:b1],
+            vert,
+            crit[b0:b1],
+            tol,
+            interior,
+            False,
+            off,
+            lo,
+            hi,
+            *g,
+        )
+        los.append(lo[: off[-1]])
+        his.append(hi[: off[-1]])
+        counts.append(np.diff(off))
+    if not los:
+        return np.zeros(0, dtype=np.int64), np.zeros(0), np.zeros(0)
+    owner = np.repeat(np.arange(n), np.concatenate(counts))
+    return owner, np.concatenate(los), np.concatenate(his)
 
 
 @_njit
