@@ -40,7 +40,9 @@ def build_parser() -> argparse.ArgumentParser:
         prog="sensorplan",
         description="Sensor planning (Briggs & Donald): train and evaluate agents, run the demo.",
     )
-    sub = parser.add_subparsers(dest="command", metavar="{train,evaluate,demo,convert,view}")
+    sub = parser.add_subparsers(
+        dest="command", metavar="{train,evaluate,benchmark,demo,convert,view}"
+    )
     sub.required = True
 
     t = sub.add_parser(
@@ -75,6 +77,24 @@ def build_parser() -> argparse.ArgumentParser:
         help="total environment steps (default: n_timesteps from the config)",
     )
     t.add_argument("--seed", type=int, default=0)
+    t.add_argument(
+        "--seeds",
+        type=int,
+        nargs="+",
+        default=None,
+        help="train once per seed, one after the other (outputs <out>_s<seed>)",
+    )
+    t.add_argument(
+        "--hp",
+        nargs="+",
+        default=None,
+        metavar="KEY=VALUE",
+        help="hyperparameter overrides, values in YAML, e.g. --hp n_steps=64 learning_rate=1e-4",
+    )
+    t.add_argument(
+        "--checkpoint-freq", type=int, default=None, help="save a checkpoint every N env steps"
+    )
+    t.add_argument("--resume", default=None, help="continue training from this model zip")
     t.add_argument(
         "--n-envs", type=int, default=None, help="parallel envs (default: n_envs from the config)"
     )
@@ -187,6 +207,28 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _hp_overrides(items: list[str] | None) -> dict:
+    """``["n_steps=64", "policy_kwargs={net_arch: [32]}"]`` -> a dict (values read as YAML)."""
+    import yaml
+
+    out = {}
+    for item in items or []:
+        key, sep, value = item.partition("=")
+        if not sep or not key:
+            raise ValueError(f"--hp wants KEY=VALUE, got {item!r}")
+        try:
+            v = yaml.safe_load(value)
+        except yaml.YAMLError as e:
+            raise ValueError(f"--hp {key}: {value!r} is not a YAML value ({e})") from e
+        if isinstance(v, str):  # YAML 1.1 reads 1e-4 as a string
+            try:
+                v = float(v)
+            except ValueError:
+                pass
+        out[key] = v
+    return out
+
+
 def main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     if argv and argv[0] == "demo":
@@ -227,24 +269,33 @@ def main(argv: list[str] | None = None) -> int:
         if args.command == "train":
             if args.env is None or args.algo is None:
                 raise ValueError("--env and --algo are required with --backend sb3")
-            from .train import train
+            from .train import default_out, train
 
-            train(
-                args.env,
-                args.algo,
-                timesteps=args.timesteps,
-                seed=args.seed,
-                n_envs=args.n_envs,
-                env_kwargs=args.env_kwargs,
-                config=args.config,
-                out=args.out,
-                eval_freq=args.eval_freq,
-                eval_episodes=args.eval_episodes,
-                vec_env=args.vec_env,
-                threads=args.threads,
-                progress_bar=False if args.no_progress else None,
-                tensorboard=False if args.no_tensorboard else None,
-            )
+            hp = _hp_overrides(args.hp)
+            seeds = args.seeds or [args.seed]
+            for s in seeds:
+                out = args.out
+                if args.seeds:
+                    out = f"{args.out}_s{s}" if args.out else default_out(args.algo, args.env, s)
+                train(
+                    args.env,
+                    args.algo,
+                    timesteps=args.timesteps,
+                    seed=s,
+                    n_envs=args.n_envs,
+                    env_kwargs=args.env_kwargs,
+                    config=args.config,
+                    out=out,
+                    eval_freq=args.eval_freq,
+                    eval_episodes=args.eval_episodes,
+                    vec_env=args.vec_env,
+                    threads=args.threads,
+                    progress_bar=False if args.no_progress else None,
+                    tensorboard=False if args.no_tensorboard else None,
+                    hp_overrides=hp,
+                    checkpoint_freq=args.checkpoint_freq,
+                    resume=args.resume,
+                )
             return 0
         if args.command == "benchmark":
             from .benchmark import DEFAULT_DIFFICULTY, benchmark

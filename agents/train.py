@@ -261,8 +261,16 @@ def train(
     tensorboard: bool | None = None,
     device: str = "cpu",
     verbose: int = 1,
+    hp_overrides: dict | None = None,
+    checkpoint_freq: int | None = None,
+    resume: str | Path | None = None,
 ) -> dict:
     """Train ``algo`` on ``env_id``; returns the resolved config with the output paths.
+
+    ``hp_overrides``: hyperparameters (and meta keys such as ``n_steps``) that replace the
+    config's.  ``checkpoint_freq``: save ``checkpoints/<algo>_<steps>_steps.zip`` every that
+    many env steps.  ``resume``: a saved model (zip) to continue training from (its step
+    count carries on).
 
     ``vec_env``: ``"batched"`` (the default, also what ``"auto"`` means: all ``n_envs``
     sub-envs in one native vector env of the batched core, seen through
@@ -290,6 +298,7 @@ def train(
             f"unknown env id {env_id!r}; sensorplan ids: {', '.join(sensorplan_gym.ENV_IDS)}"
         )
     hp = load_hyperparams(algo, env_id, config)
+    hp.update(copy.deepcopy(hp_overrides or {}))
     resolved_env_kwargs = dict(hp.pop("env_kwargs", None) or {})
     resolved_env_kwargs.update(env_kwargs or {})
     check_algo_env(algo, env_id, resolved_env_kwargs)
@@ -385,6 +394,12 @@ def train(
             ]
             + (["--env-kwargs", json.dumps(env_kwargs)] if env_kwargs else [])
             + (["--config", str(config)] if config else [])
+            + (
+                ["--hp", *(f"{k}={json.dumps(v)}" for k, v in hp_overrides.items())]
+                if hp_overrides
+                else []
+            )
+            + (["--resume", str(resume)] if resume else [])
         ),
     }
     t0 = time.perf_counter()
@@ -399,9 +414,15 @@ def train(
             f.write(f"# resolved config written by sensorplan train ({stamp})\n")
             yaml.safe_dump(rec, f, sort_keys=False)
 
-    model = algo_class(algo)(
-        policy, venv, seed=seed, verbose=0 if verbose < 2 else 1, device=device, **kwargs
-    )
+    if resume is not None:
+        if not Path(resume).exists():
+            raise FileNotFoundError(f"--resume: no saved model at {resume}")
+        model = algo_class(algo).load(resume, env=venv, device=device)
+        model.set_random_seed(seed)
+    else:
+        model = algo_class(algo)(
+            policy, venv, seed=seed, verbose=0 if verbose < 2 else 1, device=device, **kwargs
+        )
     callback = _eval_callback_cls()(
         eval_env,
         best_path=out / "best_model.zip",
@@ -420,11 +441,21 @@ def train(
         )
     try:
         warnings.filterwarnings("ignore", message="Training and eval env are not of the same type")
+        callbacks: list = [callback]
+        if checkpoint_freq:
+            from stable_baselines3.common.callbacks import CheckpointCallback
+
+            callbacks.append(
+                CheckpointCallback(
+                    max(int(checkpoint_freq) // n_envs, 1), str(out / "checkpoints"), algo
+                )
+            )
         model.learn(
             total_timesteps=n_timesteps,
-            callback=callback,
+            callback=callbacks,
             progress_bar=progress_bar,
             tb_log_name=f"{algo}_s{seed}",
+            reset_num_timesteps=resume is None,
         )
     finally:
         venv.close()
