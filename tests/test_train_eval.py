@@ -116,10 +116,23 @@ def test_dqn_on_box_env_fails_clearly(tmp_path, capsys):
             "dqn",
             timesteps=10,
             out=tmp_path / "dqn",
+            env_kwargs={"action_type": "continuous"},
             progress_bar=False,
             tensorboard=False,
             verbose=0,
         )
+    # the shipped DQN config makes the env with discrete actions
+    rec = train(
+        NAV,
+        "dqn",
+        timesteps=64,
+        out=tmp_path / "dqn_ok",
+        hp_overrides={"learning_starts": 16},
+        progress_bar=False,
+        tensorboard=False,
+        verbose=0,
+    )
+    assert rec["env_kwargs"]["action_type"] == "discrete"
     rc = main(
         [
             "train",
@@ -129,6 +142,8 @@ def test_dqn_on_box_env_fails_clearly(tmp_path, capsys):
             "dqn",
             "--timesteps",
             "10",
+            "--env-kwargs",
+            '{"action_type": "continuous"}',
             "--out",
             str(tmp_path / "dqn2"),
             "--no-progress",
