@@ -17,7 +17,8 @@ and, **in the same run on the same scenes**, the anchor: one CGAL visibility pol
 (pyvispoly's triangular expansion, ``compute_visibility_polygon``) at each of 20 free
 points, median per point.  The table gives each median, its ratio to the anchor, and
 the log-log growth slope (least squares over 100 .. 1,600 edges).  It also times
-``gym.make`` and ``reset`` of Navigate-v0 on the office floor.  Up to ``--brute-max``
+``gym.make`` and ``reset`` of Navigate-v0 on the office floor, and with ``--swept`` the
+swept partial queries at 100 edges with and without the index (same run).  Up to ``--brute-max``
 edges (default 1,600) the complete and partial queries are also timed with the grid index
 switched off (the numpy brute-force ray casts, the code path without numba), so the
 speed-up is read off one run.  Written to
@@ -209,6 +210,52 @@ def run(
     return "\n".join(lines) + "\n"
 
 
+def swept_ab(n_edges: int = 100, k: int = 5, reps: int = 3) -> str:
+    """The swept partial queries (``partial_region(target_in="goal")`` and 5.2's
+    ``recognizable_region(model="partial")``, theta 0.3, G and H regular k-gons as in
+    :mod:`benchmarks.swept`) with and without the index, alternating, each call on a freshly
+    loaded scene; medians and their ratio."""
+    from benchmarks.swept import _kgon
+    from geometry import visindex
+
+    d = scene_with_edges(n_edges, SEED)
+    d["goal"], d["failure"] = _kgon(d["goal"], k), _kgon(d["failure"], k)
+    calls = {
+        'partial_region(target_in="goal")': lambda s: partial_region(
+            s, target_in="goal", theta=0.3
+        ),
+        'recognizable_region(model="partial")': lambda s: recognizable_region(
+            s, model="partial", theta=0.3
+        ),
+    }
+    lines = [
+        "",
+        f"Swept queries, {n_edges} edges, G and H regular {k}-gons, fresh scene per call, "
+        f"median of {reps} (seconds):",
+        "",
+        "| query | with the index | without | ratio |",
+        "| --- | ---: | ---: | ---: |",
+    ]
+    saved = visindex._HAVE_NUMBA
+    try:
+        for name, fn in calls.items():
+            fn(Scene.from_dict(d))  # warm-up: numba's compiled kernels loaded, caches filled
+            res: dict[bool, list[float]] = {True: [], False: []}
+            for _ in range(reps):
+                for on in (True, False):
+                    visindex._HAVE_NUMBA = on and saved
+                    s = Scene.from_dict(d)
+                    t0 = time.perf_counter()
+                    fn(s)
+                    res[on].append(time.perf_counter() - t0)
+            a, b = statistics.median(res[True]), statistics.median(res[False])
+            lines.append(f"| `{name}` | {a:.2f} | {b:.2f} | {b / a:.1f}x |")
+            print(lines[-1], flush=True)
+    finally:
+        visindex._HAVE_NUMBA = saved
+    return "\n".join(lines) + "\n"
+
+
 def _env_times() -> tuple[float, float]:
     """Seconds of ``gym.make`` and the median ``reset`` of Navigate-v0 on the office floor."""
     import gymnasium as gym
@@ -240,10 +287,17 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument(
         "--brute-max", type=int, default=1600, help="largest scene also timed without the index"
     )
+    ap.add_argument(
+        "--swept",
+        action="store_true",
+        help="also the swept partial queries at 100 edges with and without the index",
+    )
     ap.add_argument("--out", type=Path, default=RESULTS)
     args = ap.parse_args(argv)
     edges = tuple(n for n in (args.edges or EDGES) if n <= args.max_edges)
     table = run(edges, args.reps, args.budget, office=not args.no_office, brute_max=args.brute_max)
+    if args.swept:
+        table += swept_ab()
     print(table)
     args.out.parent.mkdir(parents=True, exist_ok=True)
     cmd = "python -m benchmarks.scaling" + (
@@ -253,7 +307,7 @@ def main(argv: list[str] | None = None) -> None:
         cmd += " --edges " + " ".join(map(str, args.edges))
     if args.no_office:
         cmd += " --no-office"
-    cmd += f" --reps {args.reps}"
+    cmd += f" --reps {args.reps}" + (" --swept" if args.swept else "")
     args.out.write_text(f"# Scaling of the region queries\n\n`{cmd}`\n\n{table}", encoding="utf-8")
 
 
