@@ -212,6 +212,8 @@ class RLlibWatchPolicy:
         if self._module is None:
             from ray.rllib.core.rl_module.rl_module import RLModule
 
+            torch.set_num_threads(1)  # one small MLP forward per step: threads only contend
+
             self._module = RLModule.from_checkpoint(self.path)
         agents = list(observations)
         if not agents:
