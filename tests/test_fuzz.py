@@ -43,13 +43,13 @@ def test_regression_seeds(seed):
     _assert_clean(seed)
 
 
-@settings(max_examples=80, deadline=None)
+@settings(max_examples=60, deadline=None)
 @given(seed=st.integers(min_value=0, max_value=2**31 - 1))
 def test_fuzz_stationary_and_complete(seed):
     _assert_clean(seed)
 
 
-@settings(max_examples=4, deadline=None)
+@settings(max_examples=3, deadline=None)
 @given(seed=st.integers(min_value=0, max_value=2**31 - 1))
 def test_fuzz_swept(seed):
     _assert_clean(seed, swept=True)
