@@ -92,17 +92,20 @@ class Frame:
 
         Rounding can fold a sliver of a valid polygon (two vertices closer than the world
         coordinates' last bit): such a result is repaired (``make_valid``, areal parts
-        kept), which moves no boundary by more than that last bit."""
+        kept, twisted loops kept as areas)."""
         if self.identity:
             return g
         w = shapely.transform(g, lambda c: c * self.scale + np.array([self.ox, self.oy]))
         if w.is_empty or w.is_valid or g.geom_type not in ("Polygon", "MultiPolygon"):
             return w
+        # "linework" keeps every loop of a ring that rounding twisted (the "structure"
+        # method and buffer(0) drop the loop of the wrong orientation: 4e-6 of area lost at
+        # a 3.2e5 offset in fuzz seed 102667, against 2.4e-7 gained here)
         try:
-            fixed = shapely.make_valid(w, method="structure", keep_collapsed=False)
+            fixed = shapely.make_valid(w, method="linework")
         except shapely.errors.GEOSException:  # pragma: no cover - GEOS corner cases
-            fixed = shapely.buffer(w, 0.0)
-        return areal(fixed)
+            fixed = shapely.make_valid(w, method="structure", keep_collapsed=False)
+        return areal(shapely.union_all(shapely.get_parts(areal(fixed))))
 
     def to_world_pts(self, p: np.ndarray) -> np.ndarray:
         return np.asarray(p, dtype=float) * self.scale + np.array([self.ox, self.oy])
