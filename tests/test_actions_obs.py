@@ -143,3 +143,31 @@ def test_oracle_with_declare_hold():
     assert ok == 3
     with pytest.raises(TypeError, match="continuous"):
         OraclePolicy(gym.make("sensorplan/Navigate-v0", action_type="discrete"))
+
+
+def test_map_evidence_points_at_the_right_region():
+    """Driven by the oracle on lab, the evidence flags light up for the side the target is
+    on, and never for the other (lab's swept hulls K_G and K_H are disjoint)."""
+    import shapely
+
+    from agents.oracle import OraclePolicy
+
+    env = gym.make("sensorplan/Recognize-v0", map_evidence=True, n_beams=32)
+    n = 32
+    assert env.observation_space.shape == (8 + 5 * n,)
+    kg, kh = (shapely.Polygon(k) for k in env.unwrapped.world.must_see)
+    assert not kg.intersects(kh)
+    pol = OraclePolicy(env)
+    right = 0
+    for seed in range(4):
+        obs, _ = env.reset(seed=seed)
+        pol.reset()
+        side = env.unwrapped._side
+        for _ in range(200):
+            ev = obs[8 + 3 * n :].reshape(2, n)
+            assert not ev[1 if side == "G" else 0].any()
+            right += ev[0 if side == "G" else 1].any()
+            obs, _, term, trunc, _ = env.step(pol.predict(obs)[0])
+            if term or trunc:
+                break
+    assert right >= 4

@@ -14,7 +14,10 @@ obstacles, G, H), its own pose, and its sensor readings.  The hidden target of
     y-components; zeros where nothing was hit).  With ``map_ranges=True``, ``n_beams``
     more values: the range each beam would read on the static map (walls and obstacles,
     no target, no noise) from the commanded pose, divided by the reach -- what a robot
-    carrying the map predicts (length ``8 + 4 * n_beams``).
+    carrying the map predicts (length ``8 + 4 * n_beams``).  With ``map_evidence=True``,
+    ``2 * n_beams`` more 0/1 values (G's beams, then H's): the beam read noticeably shorter
+    than the map predicts and its end point lies in the hull of the target swept over G
+    (resp. H) -- the robot's own readings interpreted with the map (:func:`map_evidence`).
 
     Placement, length ``8 + 2 * n_beams``: centres of G and H scaled to [-1, 1],
     the width and height of G and H's bounding boxes divided by the scene's span,
@@ -78,11 +81,18 @@ def _scaled(world: World, x: float, y: float) -> tuple[float, float]:
 
 
 class RobotVectorObs:
-    def __init__(self, n_beams: int, grid_size: int = 64, map_ranges: bool = False) -> None:
+    def __init__(
+        self,
+        n_beams: int,
+        grid_size: int = 64,
+        map_ranges: bool = False,
+        map_evidence: bool = False,
+    ) -> None:
         self.n = n_beams
         n = n_beams
         self.map_ranges = map_ranges
-        m = n if map_ranges else 0
+        self.map_evidence = map_evidence
+        m = (n if map_ranges else 0) + (2 * n if map_evidence else 0)
         low = np.concatenate([-np.ones(8), np.zeros(n), -np.ones(2 * n), np.zeros(m)])
         self.space = spaces.Box(
             low.astype(np.float32), np.ones(8 + 3 * n + m, dtype=np.float32), dtype=np.float32
@@ -109,8 +119,12 @@ class RobotVectorObs:
         nrm = sim.scan_normal[sel]  # robot-frame x's, then y's
         out[:, 8 + n : 8 + 2 * n] = c1 * nrm[..., 0] + s1 * nrm[..., 1]
         out[:, 8 + 2 * n : 8 + 3 * n] = c1 * nrm[..., 1] - s1 * nrm[..., 0]
+        j = 8 + 3 * n
         if self.map_ranges:
-            out[:, 8 + 3 * n :] = sim.map_dist[sel] * K[:, 5:6]
+            out[:, j : j + n] = sim.map_dist[sel] * K[:, 5:6]
+            j += n
+        if self.map_evidence:
+            out[:, j:] = map_evidence(sim, sel, x, y, psi).reshape(len(x), 2 * n)
         # every entry is within its bounds up to rounding of order 1e-16, which the float32
         # conversion absorbs (values within 2**-25 of +-1 round to +-1)
         return out.astype(np.float32)
@@ -145,6 +159,28 @@ class RobotGridObs:
             r = np.broadcast_to(rows[:, None], hit.shape)
             out[r[hit], 4, ii[hit], jj[hit]] = 255
         return out
+
+
+def map_evidence(sim: BatchSim, sel, x, y, psi) -> np.ndarray:
+    """``(k, 2, B)`` 0/1: beam ``b`` read noticeably shorter than the static map predicts
+    (by more than ``3 noise + 1e-3 reach``) and its end point, placed from the commanded pose,
+    lies in K_G (row 0) or K_H (row 1), the hulls of the target swept over G and H -- map
+    knowledge applied to the robot's own readings, never the target's hidden location."""
+    d = sim.scan_dist[sel]
+    tol = 3.0 * sim.noise + 1e-3 * sim.reach[sel][:, None]
+    short = d < sim.map_dist[sel] - tol
+    ang = sim.offsets[sel] + psi[:, None]
+    px = x[:, None] + d * np.cos(ang)  # (k, B)
+    py = y[:, None] + d * np.sin(ang)
+    H = sim.hulls[sel]  # (k, 2, K, 2), counter-clockwise
+    ex = np.roll(H[..., 0], -1, axis=2) - H[..., 0]
+    ey = np.roll(H[..., 1], -1, axis=2) - H[..., 1]
+    # cross(e, p - v) >= 0 for every edge: inside (zero-length padding edges give 0)
+    cr = ex[:, :, None, :] * (py[:, None, :, None] - H[:, :, None, :, 1]) - ey[:, :, None, :] * (
+        px[:, None, :, None] - H[:, :, None, :, 0]
+    )
+    inside = (cr >= -1e-9 * sim.diameter[sel][:, None, None, None] ** 2).all(axis=3)
+    return (inside & short[:, None, :]).astype(np.float64)
 
 
 def _rasters(sim: BatchSim, idx: np.ndarray, size: int) -> np.ndarray:
@@ -200,10 +236,17 @@ class PlacementGridObs:
 
 
 def make_observation(
-    kind: str, obs_type: str, n_beams: int, grid_size: int, *, map_ranges: bool = False
+    kind: str,
+    obs_type: str,
+    n_beams: int,
+    grid_size: int,
+    *,
+    map_ranges: bool = False,
+    map_evidence: bool = False,
 ):
     """The observation builder for env ``kind`` ("robot" or "placement") and ``obs_type``;
-    ``map_ranges``: robot vector observations carry the map-predicted ranges too."""
+    ``map_ranges`` / ``map_evidence``: robot vector observations carry the map-predicted
+    ranges / the per-beam evidence flags too."""
     if obs_type not in OBS_TYPES:
         raise ValueError(f"obs_type must be one of {OBS_TYPES}, got {obs_type!r}")
     table = {
@@ -212,6 +255,6 @@ def make_observation(
         ("placement", "vector"): PlacementVectorObs,
         ("placement", "grid"): PlacementGridObs,
     }
-    if map_ranges:
-        return RobotVectorObs(n_beams, grid_size, map_ranges=True)
+    if map_ranges or map_evidence:
+        return RobotVectorObs(n_beams, grid_size, map_ranges=map_ranges, map_evidence=map_evidence)
     return table[(kind, obs_type)](n_beams, grid_size)

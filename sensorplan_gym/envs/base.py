@@ -36,6 +36,9 @@ action_type : ``"continuous"`` (default) | ``"discrete"`` (see :mod:`sensorplan_
 map_ranges : bool, default False -- Navigate/Recognize vector observations also carry, per
     beam, the range the static map predicts from the commanded pose (see
     :mod:`sensorplan_gym.core.observations`): a reading that differs reveals the target.
+map_evidence : bool, default False -- per beam, whether it read shorter than the map predicts
+    and ended in the hull of the target swept over G, resp. H (the readings interpreted with
+    the map; vector observations of Navigate/Recognize).
 max_steps : int | None -- the time limit (default 200; Placement: 1).
 random_scene_kwargs : dict | None -- passed to ``random_scene`` when ``scene="random"``.
 render_mode : ``None`` | ``"rgb_array"`` | ``"human"``.
@@ -158,6 +161,7 @@ class SensorPlanBatch(BatchSim):
         max_steps: int | None = None,
         action_type: str = "continuous",
         map_ranges: bool = False,
+        map_evidence: bool = False,
         **action_kw: Any,
     ) -> None:
         for name, v in (
@@ -189,14 +193,20 @@ class SensorPlanBatch(BatchSim):
         if unknown or (action_kw and self.action_task != "placement"):
             bad = sorted(action_kw if not unknown else unknown)
             raise TypeError(f"{self.task_name}: unexpected keyword argument(s) {bad}")
-        if not isinstance(map_ranges, bool):
-            raise ValueError(f"map_ranges must be True or False, got {map_ranges!r}")
-        if map_ranges and (obs_type != "vector" or self.obs_kind != "robot"):
-            raise ValueError("map_ranges=True needs obs_type='vector' in Navigate or Recognize")
-        self.map_ranges = map_ranges
+        for name, v in (("map_ranges", map_ranges), ("map_evidence", map_evidence)):
+            if not isinstance(v, bool):
+                raise ValueError(f"{name} must be True or False, got {v!r}")
+            if v and (obs_type != "vector" or self.obs_kind != "robot"):
+                raise ValueError(f"{name}=True needs obs_type='vector' in Navigate or Recognize")
+        self.map_ranges = map_ranges or map_evidence  # the sim computes the map's ranges
         self.obs_type = obs_type
         self.obs = make_observation(
-            self.obs_kind, obs_type, self.n_beams, grid_size, map_ranges=map_ranges
+            self.obs_kind,
+            obs_type,
+            self.n_beams,
+            grid_size,
+            map_ranges=map_ranges,
+            map_evidence=map_evidence,
         )
         self.single_observation_space = self.obs.space
         self.actions = make_actions(action_type, self.action_task, self.action_dim, **action_kw)
