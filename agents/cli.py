@@ -207,6 +207,34 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+#: top-level modules of the optional extras -> the extra that installs them
+EXTRA_OF_MODULE = {
+    "yaml": "rl",
+    "stable_baselines3": "rl",
+    "torch": "rl",
+    "tqdm": "rl",
+    "rich": "rl",
+    "tensorboard": "rl",
+    "pettingzoo": "multi",
+    "ray": "multi",
+    "bokeh": "viewer",
+}
+
+
+def _missing_extra_message(command: str, err: ImportError) -> str | None:
+    """The 'install this extra' message for an ImportError of an optional dependency, or
+    ``None`` when the missing module belongs to no extra (a real bug: re-raise it)."""
+    name = (getattr(err, "name", None) or "").split(".")[0]
+    extra = EXTRA_OF_MODULE.get(name)
+    if extra is None:
+        return None
+    return (
+        f"sensorplan {command}: error: the Python module {name!r} is missing; it comes with "
+        f'the "{extra}" extra: pip install -e ".[{extra}]" in a checkout, '
+        f'pip install "sensorplan-gym[{extra}]" otherwise'
+    )
+
+
 def _hp_overrides(items: list[str] | None) -> dict:
     """``["n_steps=64", "policy_kwargs={net_arch: [32]}"]`` -> a dict (values read as YAML)."""
     import yaml
@@ -232,9 +260,16 @@ def _hp_overrides(items: list[str] | None) -> dict:
 def main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     if argv and argv[0] == "demo":
-        from . import demo  # lazily: the demo pulls in plotting and the oracle
+        try:
+            from . import demo  # lazily: the demo pulls in plotting and the oracle
 
-        rc = demo.main(argv[1:])
+            rc = demo.main(argv[1:])
+        except ImportError as err:
+            msg = _missing_extra_message("demo", err)
+            if msg is None:
+                raise
+            print(msg, file=sys.stderr)
+            return 2
         return int(rc or 0)
     if argv and argv[0] == "view":
         from sensorplan_gym.viewer.cli import main as view_main  # lazily: Bokeh is an extra
@@ -326,6 +361,12 @@ def main(argv: list[str] | None = None) -> int:
                 address=args.address,
             )
             return 0
+    except ImportError as err:
+        msg = _missing_extra_message(args.command, err)
+        if msg is None:
+            raise
+        print(msg, file=sys.stderr)
+        return 2
     except (ValueError, KeyError, FileNotFoundError, NotImplementedError) as err:
         msg = err.args[0] if isinstance(err, KeyError) and err.args else err
         print(f"sensorplan {args.command}: error: {msg}", file=sys.stderr)

@@ -18,6 +18,7 @@ Figures and the evaluation files go to the folder given by ``--out`` (default
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import math
 import time
 from pathlib import Path
@@ -25,6 +26,23 @@ from pathlib import Path
 import numpy as np
 
 __all__ = ["figure_15", "figure_16", "main", "merge_short_legs"]
+
+#: modules of the ``rl`` extra that loading the shipped PPO policies needs
+RL_MODULES = ("yaml", "stable_baselines3", "torch")
+
+#: ``sensorplan demo --help`` text (plain, no reST markup)
+_HELP_TEXT = """\
+The paper's surveillance scenario end to end (section 6), on the bundled 'lab' scene:
+
+  1. the exact complete-visibility region of the doorway G (paper Figure 15);
+  2. the recognizable region R(G) n R(H) - C(G, H), shrunk for safety, the chosen
+     placement, the aim and the motion to it (Figure 16);
+  3. the oracle drives there in Recognize-v0 and declares G or H from its range readings;
+  4. oracle vs the shipped PPO policies vs random on Navigate-v0 (lab): a table.
+     The PPO policies need the rl extra (pip install -e ".[rl]"); without it the
+     table has oracle and random only.
+
+Figures and evaluation files go to --out (default: sensorplan-demo)."""
 
 PRETRAINED = [
     Path(__file__).parent / "pretrained" / "ppo_navigate_lab.zip",
@@ -239,7 +257,11 @@ def _recognize(out: Path, seed: int) -> tuple[str, str, int]:
 
 def main(argv: list[str] | None = None) -> int:
     """Run the demo; returns a process exit code."""
-    ap = argparse.ArgumentParser(prog="sensorplan demo", description=__doc__.split("\n\n")[0])
+    ap = argparse.ArgumentParser(
+        prog="sensorplan demo",
+        description=_HELP_TEXT,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     ap.add_argument("--out", default="sensorplan-demo", help="folder for figures and results")
     ap.add_argument(
         "--episodes",
@@ -301,9 +323,17 @@ def main(argv: list[str] | None = None) -> int:
     print(f"4. Navigate-v0 (lab), {args.episodes} episodes per policy:")
     from .evaluate import evaluate, format_table
 
-    policies = ["oracle", "random"] + [str(p) for p in PRETRAINED if p.exists()]
-    if len(policies) == 2:
-        print("   (no shipped policy found; evaluating oracle and random only)")
+    policies = ["oracle", "random"]
+    missing = [m for m in RL_MODULES if importlib.util.find_spec(m) is None]
+    if missing:
+        print(
+            f"   (the shipped PPO policies need the rl extra -- missing {', '.join(missing)}; "
+            f'install it with: pip install -e ".[rl]"; evaluating oracle and random only)'
+        )
+    else:
+        policies += [str(p) for p in PRETRAINED if p.exists()]
+        if len(policies) == 2:
+            print("   (no shipped policy found; evaluating oracle and random only)")
     res = evaluate(
         "sensorplan/Navigate-v0",
         policies,
