@@ -41,3 +41,39 @@ def test_demo_help_is_plain_text(capsys):
     assert "``" not in out and ":func:" not in out
     assert 'pip install -e ".[rl]"' in out
     assert "Recognize-v0" in out
+
+
+@pytest.mark.parametrize("random_start", [False, True])
+def test_warehouse_partial_stationary_gets_a_usable_start(random_start):
+    """The warehouse's own start already recognizes under the partial/stationary model: the
+    env falls back to a start drawn from a fixed generator that does not recognize and from
+    which the region is reachable (the same one every time)."""
+    import gymnasium as gym
+
+    from sensorplan_gym.core.world import load_scene
+
+    kw = dict(scene="warehouse", model="partial", motion="stationary", random_start=random_start)
+    env = gym.make("sensorplan_gym:sensorplan/Navigate-v0", **kw)
+    u = env.unwrapped
+    scene_start = tuple(float(v) for v in load_scene("warehouse").start)
+    assert u.world.recognizing(*scene_start)  # why the fallback is needed
+    assert u.start != scene_start
+    assert not u.world.recognizing(*u.start)
+    assert not u.world.reachable_region(u.start[:2]).is_empty
+    again = gym.make("sensorplan_gym:sensorplan/Navigate-v0", **kw).unwrapped.start
+    assert again == u.start
+    for seed in range(3):
+        env.reset(seed=seed)
+        assert not u.world.recognizing(*u.pose)
+        env.step(env.action_space.sample())
+    env.close()
+
+
+def test_fine_scene_start_is_kept():
+    import gymnasium as gym
+
+    from sensorplan_gym.core.world import load_scene
+
+    for scene in ("lab", "warehouse"):
+        u = gym.make("sensorplan_gym:sensorplan/Navigate-v0", scene=scene).unwrapped
+        assert u.start == tuple(float(v) for v in load_scene(scene).start)

@@ -104,12 +104,36 @@ def _scene_problem(world: World, start: Start, needs_start: bool) -> str | None:
     return None
 
 
+def _sampled_start(world: World, rng: np.random.Generator, tries: int = 10_000) -> Start | None:
+    """A start drawn from ``rng``: a uniform free position outside the recognizable region in
+    a free-space component that meets the region (so the region is reachable), with a uniform
+    heading; ``None`` when ``tries`` draws find none."""
+    comps = shapely.get_parts(world.robot_space)
+    space = shapely.union_all(comps[shapely.intersects(comps, world.region)])
+    if space.is_empty:
+        return None
+    shapely.prepare(space)
+    for _ in range(tries):
+        x = float(rng.uniform(world.lo[0], world.hi[0]))
+        y = float(rng.uniform(world.lo[1], world.hi[1]))
+        if shapely.contains_xy(space, x, y) and not world.in_region(x, y):
+            return (x, y, float(rng.uniform(-math.pi, math.pi)))
+    return None
+
+
 def _check(
-    world: World, rng: np.random.Generator, needs_start: bool, min_start_distance: float = 0.0
+    world: World,
+    rng: np.random.Generator,
+    needs_start: bool,
+    min_start_distance: float = 0.0,
+    fallback_start: bool = False,
 ):
     """``(start, problem)`` of a world: its start pose and why it cannot host an episode
     (``None`` if it can).  With ``min_start_distance`` > 0 the start is drawn uniformly among
-    the free positions at least that fraction of the diameter away from the region."""
+    the free positions at least that fraction of the diameter away from the region.  With
+    ``fallback_start`` (a fixed scene), a scene start that already recognizes or cannot reach
+    the region is replaced by a start drawn from ``rng`` (:func:`_sampled_start`); only when
+    none exists is the problem returned.  A scene whose own start is fine keeps it."""
     if needs_start and min_start_distance > 0:
         thr = min_start_distance * world.diameter
         for _ in range(500):
@@ -123,7 +147,13 @@ def _check(
         start = _start_pose(world, rng, needs_start)
     except ValueError as e:
         return None, str(e)
-    return start, _scene_problem(world, start, needs_start)
+    problem = _scene_problem(world, start, needs_start)
+    if problem and fallback_start and needs_start and not world.region.is_empty:
+        alt = _sampled_start(world, rng)
+        if alt is not None and _scene_problem(world, alt, needs_start) is None:
+            return alt, None
+        problem += " (and no free start outside the region can reach it)"
+    return start, problem
 
 
 class SensorPlanBatch(BatchSim):
@@ -233,7 +263,7 @@ class SensorPlanBatch(BatchSim):
         else:
             sc = load_scene(scene)
             world = get_world(sc, self.cfg)
-            start, problem = check(world, np.random.default_rng(0))
+            start, problem = check(world, np.random.default_rng(0), fallback_start=True)
             if problem:
                 raise ValueError(f"scene {sc.name!r} unusable for {self.task_name}: {problem}")
             self.source = FixedScene(world, start)
