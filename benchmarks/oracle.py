@@ -4,7 +4,9 @@ For every environment, every bundled scene (N episodes each, evaluation seeds
 1_000_000 onwards) and M procedural scenes (``geometry.generate.random_scene``, one
 episode each).  A random scene whose recognizable region is empty, or not reachable
 from any start, has no recognizing placement: it is excluded from the rate and counted
-separately.  Prints a markdown table and writes ``benchmarks/results/oracle.md``.
+separately.  Prints a markdown table and writes it to ``--out`` (default
+``runs/benchmarks/oracle.md``); the tracked ``benchmarks/results/oracle.md`` is
+rewritten only with ``--update-results``.
 """
 
 from __future__ import annotations
@@ -23,6 +25,10 @@ from geometry.generate import random_scene
 ENVS = ["sensorplan/Placement-v0", "sensorplan/Navigate-v0", "sensorplan/Recognize-v0"]
 SCENES = ["lab", "edr", "corridor", "warehouse"]
 SEED0 = 1_000_000
+#: the tracked results file (rewritten only with --update-results)
+TRACKED = Path(__file__).parent / "results" / "oracle.md"
+#: where a run writes by default (runs/ is git-ignored)
+DEFAULT_OUT = Path("runs") / "benchmarks" / "oracle.md"
 
 
 def episode(env, policy, seed: int) -> bool:
@@ -40,6 +46,17 @@ def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--episodes", type=int, default=100)
     ap.add_argument("--random-scenes", type=int, default=200)
+    ap.add_argument(
+        "--out",
+        type=Path,
+        default=DEFAULT_OUT,
+        help=f"markdown file for the table (default {DEFAULT_OUT})",
+    )
+    ap.add_argument(
+        "--update-results",
+        action="store_true",
+        help=f"write the tracked {TRACKED} instead of --out",
+    )
     args = ap.parse_args(argv)
     rows = [
         "| env | scene | episodes | successes | success rate | excluded (no placement) |",
@@ -75,8 +92,8 @@ def main(argv: list[str] | None = None) -> None:
         )
         print(rows[-1], flush=True)
     table = "\n".join(rows)
-    out = Path(__file__).parent / "results" / "oracle.md"
-    out.parent.mkdir(exist_ok=True)
+    out = TRACKED if args.update_results else args.out
+    out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text("# Oracle success (`python -m benchmarks.oracle`)\n\n" + table + "\n")
     print(f"\n{table}\n\n({time.perf_counter() - t0:.0f} s; written to {out})")
 

@@ -77,3 +77,20 @@ def test_fine_scene_start_is_kept():
     for scene in ("lab", "warehouse"):
         u = gym.make("sensorplan_gym:sensorplan/Navigate-v0", scene=scene).unwrapped
         assert u.start == tuple(float(v) for v in load_scene(scene).start)
+
+
+def test_oracle_benchmark_leaves_the_tracked_results_alone(tmp_path, monkeypatch):
+    import benchmarks.oracle as bo
+
+    tracked = tmp_path / "tracked" / "oracle.md"
+    monkeypatch.setattr(bo, "TRACKED", tracked)
+    monkeypatch.setattr(bo, "ENVS", ["sensorplan/Placement-v0"])
+    monkeypatch.setattr(bo, "SCENES", ["lab"])
+    out = tmp_path / "out" / "oracle.md"
+    bo.main(["--episodes", "1", "--random-scenes", "0", "--out", str(out)])
+    assert out.is_file() and not tracked.exists()
+    assert "| sensorplan/Placement-v0 | lab | 1 |" in out.read_text()
+    out.unlink()
+    bo.main(["--episodes", "1", "--random-scenes", "0", "--out", str(out), "--update-results"])
+    assert tracked.is_file() and not out.exists()
+    assert bo.DEFAULT_OUT.parts[0] == "runs"  # git-ignored
