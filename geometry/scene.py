@@ -419,8 +419,22 @@ class Scene:
         return copy.deepcopy(self._data)
 
     def save(self, path: str | PathLike[str]) -> None:
-        """Write the scene as JSON (``load(save(s)) == s``)."""
-        Path(path).write_text(json.dumps(self._data, indent=2) + "\n", encoding="utf-8")
+        """Write the scene as JSON (``load(save(s)) == s``), indented, with every list of
+        numbers -- a vertex ``[x, y]``, a pose, a sensor range -- on one line, so a polygon
+        reads one vertex per line.  Floats are written as ``repr`` (round trips are exact)."""
+
+        def dump(v: Any, pad: str) -> str:
+            inner = pad + "  "
+            if isinstance(v, Mapping) and v:
+                items = (f"{inner}{json.dumps(k)}: {dump(x, inner)}" for k, x in v.items())
+                return "{\n" + ",\n".join(items) + "\n" + pad + "}"
+            if isinstance(v, (list, tuple)) and any(
+                isinstance(x, (list, tuple, Mapping)) for x in v
+            ):
+                return "[\n" + ",\n".join(inner + dump(x, inner) for x in v) + "\n" + pad + "]"
+            return json.dumps(v)
+
+        Path(path).write_text(dump(self._data, "") + "\n", encoding="utf-8")
 
     def replace(self, **changes: Any) -> Scene:
         """A new validated scene with some JSON keys replaced (``None`` removes sensor/start)."""

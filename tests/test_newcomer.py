@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import sys
 
 import pytest
@@ -94,3 +95,23 @@ def test_oracle_benchmark_leaves_the_tracked_results_alone(tmp_path, monkeypatch
     bo.main(["--episodes", "1", "--random-scenes", "0", "--out", str(out), "--update-results"])
     assert tracked.is_file() and not out.exists()
     assert bo.DEFAULT_OUT.parts[0] == "runs"  # git-ignored
+
+
+def test_scene_save_writes_one_vertex_per_line_and_round_trips_exactly(tmp_path):
+    import json
+
+    from geometry.scene import Scene
+    from sensorplan_gym.core.world import load_scene
+
+    d = load_scene("lab").to_dict()
+    d["obstacles"][0][0] = [0.1 + 0.2, 1 / 3]  # floats that need all 17 digits
+    scene = Scene.from_dict(d)
+    path = tmp_path / "lab.json"
+    scene.save(path)
+    text = path.read_text()
+    assert "    [0.30000000000000004, 0.3333333333333333],\n" in text
+    n_vertices = len(d["bounds"]) + sum(len(o) for o in d["obstacles"])
+    vertex_lines = [ln for ln in text.splitlines() if re.fullmatch(r"\s*\[[^\[\]]+\],?", ln)]
+    assert len(vertex_lines) >= n_vertices
+    assert json.loads(text) == d
+    assert Scene.load(path).to_dict() == scene.to_dict()
