@@ -483,6 +483,12 @@ class Scene:
                 )
             if not all(math.isfinite(c) for c in start_in):
                 raise SceneError(f"start: non-finite value in {start_in!r}")
+            if abs(start_in[2]) > 2 * math.pi:
+                raise SceneError(
+                    f"start[2] (theta): {start_in[2]!r} is outside [-2 pi, 2 pi]; theta is in "
+                    f"radians (did you mean {start_in[2]!r} degrees = "
+                    f"{math.radians(start_in[2]):.6g} rad?)"
+                )
             start = (float(start_in[0]), float(start_in[1]), float(start_in[2]))
 
         set_("name", name)

@@ -115,3 +115,57 @@ def test_scene_save_writes_one_vertex_per_line_and_round_trips_exactly(tmp_path)
     assert len(vertex_lines) >= n_vertices
     assert json.loads(text) == d
     assert Scene.load(path).to_dict() == scene.to_dict()
+
+
+def test_start_heading_in_degrees_is_caught():
+    import math
+
+    import gymnasium as gym
+
+    from geometry.scene import SceneError
+    from sensorplan_gym.core.world import load_scene
+
+    lab = load_scene("lab")
+    x, y, _ = lab.start
+    with pytest.raises(SceneError, match=r"start\[2\] \(theta\).*radians.*1\.5708"):
+        lab.replace(start=[x, y, 90])
+    assert lab.replace(start=[x, y, -6.0]).start[2] == -6.0  # a valid angle in radians stays
+    env = gym.make("sensorplan_gym:sensorplan/Navigate-v0", scene="lab")
+    env.reset(seed=0, options={"start": (x, y, 90.0)})
+    psi = env.unwrapped.pose[2]
+    assert -math.pi <= psi <= math.pi and math.isclose(math.cos(psi), math.cos(90.0))
+    with pytest.raises(ValueError, match="non-finite"):
+        env.reset(seed=0, options={"start": (x, y, math.nan)})
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        (dict(target_at=("2", 2, 0)), "target_at must be"),
+        (dict(target_in="goal", theta="0"), "theta must be"),
+    ],
+)
+def test_region_queries_reject_strings(kwargs, match):
+    from geometry import complete_region
+    from sensorplan_gym.core.world import load_scene
+
+    with pytest.raises(ValueError, match=match):
+        complete_region(load_scene("lab"), **kwargs)
+
+
+def test_eps_aim_of_pi_or_more_is_rejected():
+    import math
+
+    import gymnasium as gym
+
+    from geometry import partial_region
+    from geometry.scene import SceneError
+    from sensorplan_gym.core.world import load_scene
+
+    lab = load_scene("lab")
+    with pytest.raises(ValueError, match=r"eps_aim must be in \[0, pi\)"):
+        partial_region(lab, target_in="goal", eps_aim=math.pi)
+    with pytest.raises(ValueError, match=r"eps_aim must be in \[0, pi\)"):
+        gym.make("sensorplan_gym:sensorplan/Navigate-v0", eps_aim=4.0)
+    with pytest.raises(SceneError, match=r"sensor\.eps_aim_deg: must be in \[0, 180\)"):
+        lab.replace(sensor={**lab.to_dict()["sensor"], "eps_aim_deg": 180})

@@ -400,6 +400,9 @@ class RobotBatch(SensorPlanBatch):
         start = options.get("start")
         if start is not None:
             x, y, psi = (float(v) for v in start)
+            if not all(math.isfinite(v) for v in (x, y, psi)):
+                raise ValueError(f"options['start'] = {start!r}: non-finite value")
+            psi = math.remainder(psi, 2 * math.pi)  # the heading in [-pi, pi], radians
             if not self.worlds[i].in_free_space(x, y):
                 raise ValueError(f"options['start'] = {start!r} is not in the robot's free space")
             self.set_pose(i, (x, y, psi))
