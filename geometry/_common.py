@@ -16,7 +16,7 @@ import numpy as np
 import shapely
 from shapely import affinity
 
-from ._shapes import polygonal
+from ._shapes import disc_sum, polygonal
 from ._vis import Domain, domain_from_geometry
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -94,7 +94,7 @@ class TargetSpec:
     def hull(self) -> shapely.Geometry:
         h = shapely.convex_hull(shapely.multipoints(self.hull_pts))
         if self.radius > 0:
-            h = h.buffer(self.radius * OUTER, quad_segs=QUAD_SEGS)
+            h = disc_sum(h, self.radius)
         return h
 
 
@@ -139,7 +139,7 @@ def target_spec(
         if theta is None:
             r = float(scene.target_radius)
             pts = hull_points(region)
-            area = region.buffer(r * OUTER, quad_segs=QUAD_SEGS)
+            area = disc_sum(region, r)
             center = (
                 np.asarray(shapely.convex_hull(region).centroid.coords[0])
                 if len(pts) > 2
@@ -313,7 +313,7 @@ def shrink_for_position(
     # slivers along obstacle edges, which must not grow into eps-wide bands
     delta = 1e-9 * max(_diag(allowed), 1.0)
     shadows = shapely.buffer(shadows, -delta, join_style="mitre")
-    grown = shapely.buffer(shadows, eps_pos * OUTER + 2 * delta, quad_segs=QUAD_SEGS)
+    grown = disc_sum(shadows, eps_pos + 2 * delta)
     return _polygonal(shapely.difference(region, grown))
 
 

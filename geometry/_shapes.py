@@ -8,7 +8,11 @@ from __future__ import annotations
 import numpy as np
 import shapely
 
-__all__ = ["areal", "ccw_ring", "cross", "polygonal"]
+__all__ = ["DISC_SIDES", "areal", "ccw_ring", "cross", "disc_sum", "polygonal"]
+
+#: Sides of the polygon that stands for a disc (circumscribed: it contains the disc and its
+#: boundary lies within R (1/cos(pi/DISC_SIDES) - 1) = 0.0012 R of the circle).
+DISC_SIDES = 64
 
 #: A part whose area is below this times its squared perimeter is float noise (a
 #: 1e-16-wide strip along an edge left by a boolean operation).
@@ -54,3 +58,42 @@ def polygonal(g: shapely.Geometry, *, slivers: bool = True) -> shapely.Geometry:
     if len(parts) == 1:
         return parts[0]
     return shapely.multipolygons(parts)
+
+
+def disc_sum(g: shapely.Geometry, radius: float) -> shapely.Geometry:
+    """A polygon containing the Minkowski sum ``g (+) disc(radius)`` and within
+    ``0.0012 radius`` of it: ``g`` united with, for every boundary segment, the convex
+    hull of two regular ``DISC_SIDES``-gons circumscribing the discs at its ends.
+
+    Unlike ``shapely.buffer`` (GEOS simplifies the input by up to 1 % of the distance and
+    places its arc vertices *on* the circle, so its chords cut into the disc: 0.1 % of the
+    radius was measured), every point within ``radius`` of ``g`` is inside the result."""
+    if radius <= 0 or g.is_empty:
+        return g
+    k = np.arange(DISC_SIDES)
+    ang = 2.0 * np.pi * (k + 0.5) / DISC_SIDES
+    disc = (radius / np.cos(np.pi / DISC_SIDES)) * np.column_stack([np.cos(ang), np.sin(ang)])
+    segs = []
+    for part in shapely.get_parts(g):
+        if part.geom_type == "Polygon":
+            rings = [part.exterior, *part.interiors]
+        elif part.geom_type in ("LineString", "LinearRing"):
+            rings = [part]
+        else:  # points
+            rings = []
+            for c in shapely.get_coordinates(part):
+                segs.append(np.stack([c, c]))
+        for ring in rings:
+            c = np.asarray(ring.coords)[:, :2]
+            if len(c) == 1:
+                c = np.vstack([c, c])
+            segs.extend(np.stack([c[:-1], c[1:]], axis=1))
+    if not segs:
+        return g
+    ends = np.asarray(segs)  # (S, 2, 2)
+    pts = (ends[:, :, None, :] + disc[None, None, :, :]).reshape(len(ends), 2 * DISC_SIDES, 2)
+    hulls = shapely.convex_hull(shapely.multipoints(pts))
+    pieces = [hulls]
+    if g.geom_type in ("Polygon", "MultiPolygon"):
+        pieces.append(np.asarray([g], dtype=object))
+    return areal(shapely.union_all(np.concatenate(pieces)))

@@ -28,8 +28,6 @@ import numpy as np
 import shapely
 
 from ._common import (
-    OUTER,
-    QUAD_SEGS,
     Budget,
     as_scene,
     check_aim,
@@ -43,7 +41,7 @@ from ._common import (
     target_spec,
 )
 from ._frame import world_messages
-from ._shapes import ccw_ring
+from ._shapes import ccw_ring, disc_sum
 from .sweep import swept_shadows
 from .weak import ENV, UNWANTED, WANTED, weak_visibility  # noqa: F401 (re-exported)
 
@@ -207,7 +205,7 @@ def _swept_region(
         what=budget.what,
     )
     if conservative:
-        shadows = shapely.buffer(shadows, tol * OUTER, quad_segs=QUAD_SEGS)
+        shadows = disc_sum(shadows, tol)
     allowed = shapely.difference(scene.free_space, spec.area)
     out = polygonal(shapely.difference(allowed, shadows))
     if eps_pos > 0:

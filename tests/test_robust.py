@@ -424,3 +424,21 @@ def test_reference_point_anywhere(ref):
     any1 = complete_region(s1, target_in="goal", theta=None)
     assert shapely.difference(any1, pairs[0][1]).area < tiny
     assert recognizable_region(s1).is_valid
+
+
+def test_disc_sum_contains_the_exact_minkowski_sum():
+    """GEOS buffers cut into the disc (simplification, vertices on the circle): the
+    rotating target's swept area and the eps_pos growth use geometry._shapes.disc_sum."""
+    from geometry._shapes import disc_sum
+
+    g = shapely.Polygon([(0, 0), (1, 0.1), (1.3, 1.0), (0.4, 0.6), (0.1, 1.2)])
+    r = 0.37
+    out = disc_sum(g, r)
+    ring = shapely.get_coordinates(out.exterior)
+    mids = 0.5 * (ring[1:] + ring[:-1])
+    d = shapely.distance(g, shapely.points(np.vstack([ring, mids])))
+    assert d.min() >= r * (1 - 1e-12) and d.max() <= r * 1.0013
+    # the buffer this replaced: chords inside the disc
+    b = shapely.get_coordinates(g.buffer(r / math.cos(math.pi / 64), quad_segs=16).exterior)
+    assert shapely.distance(g, shapely.points(0.5 * (b[1:] + b[:-1]))).min() < r * (1 - 1e-5)
+    assert disc_sum(shapely.Point(1, 2), 1.0).contains(shapely.Point(1, 2).buffer(0.999))
