@@ -237,7 +237,7 @@ def _eval_callback_cls():
                     self.write_config(self.best_path.with_suffix(".yaml"), self.best_info)
                     if self.verbose:
                         print(
-                            f"new best model: success {sr:.3f}, return "
+                            f"new best model: success {sr:.3f}, return (with any shaping) "
                             f"{self.last_mean_reward:.3f} at {self.num_timesteps} steps"
                         )
             return cont
@@ -441,6 +441,14 @@ def train(
             f"seed {seed}, {n_envs} x {vec_name} -> {out}",
             flush=True,
         )
+        if resolved_env_kwargs.get("shaping"):
+            print(
+                f"note: the returns printed while training (SB3's 'episode_reward', the best "
+                f"model's 'return') include the reward shaping (shaping="
+                f"{resolved_env_kwargs['shaping']}); `sensorplan evaluate` reports the "
+                "task's return without shaping, so the two differ",
+                flush=True,
+            )
     try:
         warnings.filterwarnings("ignore", message="Training and eval env are not of the same type")
         callbacks: list = [callback]

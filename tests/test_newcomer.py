@@ -169,3 +169,28 @@ def test_eps_aim_of_pi_or_more_is_rejected():
         gym.make("sensorplan_gym:sensorplan/Navigate-v0", eps_aim=4.0)
     with pytest.raises(SceneError, match=r"sensor\.eps_aim_deg: must be in \[0, 180\)"):
         lab.replace(sensor={**lab.to_dict()["sensor"], "eps_aim_deg": 180})
+
+
+def test_training_says_its_returns_include_shaping(tmp_path, capsys):
+    pytest.importorskip("stable_baselines3")
+    yaml = pytest.importorskip("yaml")
+    from agents.train import train
+
+    nav = "sensorplan/Navigate-v0"
+    tiny = {
+        "n_steps": 32,
+        "batch_size": 32,
+        "n_epochs": 1,
+        "policy_kwargs": {"net_arch": [8]},
+        "env_kwargs": {"scene": "lab", "shaping": 1.0},
+    }
+    cfg = tmp_path / "tiny.yaml"
+    cfg.write_text(yaml.safe_dump({nav: tiny}))
+    kw = dict(timesteps=32, seed=0, n_envs=1, vec_env="dummy", progress_bar=False)
+    train(nav, "ppo", config=cfg, out=tmp_path / "a", tensorboard=False, eval_freq=10**6, **kw)
+    out = capsys.readouterr().out
+    assert "include the reward shaping (shaping=1.0)" in out
+    assert "`sensorplan evaluate` reports the task's return without shaping" in out
+    cfg.write_text(yaml.safe_dump({nav: {**tiny, "env_kwargs": {"scene": "lab"}}}))
+    train(nav, "ppo", config=cfg, out=tmp_path / "b", tensorboard=False, eval_freq=10**6, **kw)
+    assert "shaping" not in capsys.readouterr().out
