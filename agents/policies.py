@@ -134,6 +134,8 @@ def load_policy(spec: str, env, *, seed: int = 0, device: str = "cpu"):
     for name in order:
         try:
             return algo_class(name).load(str(path), device=device)
+        except ImportError:  # the rl extra is missing: say so (agents.cli names the extra)
+            raise
         except Exception as e:  # noqa: BLE001 - try the next algorithm
             errors.append(f"{name}: {type(e).__name__}: {e}")
     raise ValueError(f"could not load {path} with any of {order}:\n  " + "\n  ".join(errors))

@@ -194,3 +194,17 @@ def test_training_says_its_returns_include_shaping(tmp_path, capsys):
     cfg.write_text(yaml.safe_dump({nav: {**tiny, "env_kwargs": {"scene": "lab"}}}))
     train(nav, "ppo", config=cfg, out=tmp_path / "b", tensorboard=False, eval_freq=10**6, **kw)
     assert "shaping" not in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("module", ["yaml", "stable_baselines3"])
+def test_evaluate_model_without_rl_extra_names_the_extra(module, monkeypatch, capsys, tmp_path):
+    from pathlib import Path
+
+    zip_ = Path(__file__).resolve().parent.parent / "agents/pretrained/ppo_navigate_lab.zip"
+    monkeypatch.setitem(sys.modules, module, None)
+    rc = main(
+        ["evaluate", "--env", "sensorplan/Navigate-v0", "--policies", str(zip_),
+         "--episodes", "1", "--out", str(tmp_path / "ev"), "--no-plot"]
+    )  # fmt: skip
+    assert rc == 2
+    assert 'pip install -e ".[rl]"' in capsys.readouterr().err
