@@ -208,3 +208,37 @@ def test_evaluate_model_without_rl_extra_names_the_extra(module, monkeypatch, ca
     )  # fmt: skip
     assert rc == 2
     assert 'pip install -e ".[rl]"' in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    ("env_id", "cls_path", "vec_len", "n_discrete"),
+    [
+        ("sensorplan/Placement-v0", "placement:PlacementEnv", lambda n: 8 + 2 * n, 16 * 16 * 8),
+        ("sensorplan/Navigate-v0", "navigate:NavigateEnv", lambda n: 8 + 3 * n, 7),
+        ("sensorplan/Recognize-v0", "recognize:RecognizeEnv", lambda n: 8 + 3 * n, 9),
+    ],
+)
+def test_env_class_docstrings_match_the_spaces(env_id, cls_path, vec_len, n_discrete):
+    """help(EnvClass) shows a Gymnasium-style docstring whose stated spaces are the real ones."""
+    import importlib
+
+    import gymnasium as gym
+
+    mod, name = cls_path.split(":")
+    cls = getattr(importlib.import_module(f"sensorplan_gym.envs.{mod}"), name)
+    doc = cls.__doc__ or ""
+    sections = ["Description", "Action Space", "Observation Space", "Rewards"]
+    sections += ["Starting State", "Episode End", "Arguments", "Version History"]
+    for section in sections:
+        assert f"## {section}" in doc, section
+    assert f"Discrete({n_discrete})" in doc or "Discrete(G * G * A)" in doc
+    env = gym.make(env_id, n_beams=12)
+    assert env.observation_space.shape == (vec_len(12),)
+    dim = env.action_space.shape[0]
+    assert f"Box(-1, 1, ({dim},), float32)" in doc
+    denv = gym.make(env_id, action_type="discrete")
+    assert denv.action_space.n == n_discrete
+    if "Navigate" in env_id or "Recognize" in env_id:
+        both = gym.make(env_id, n_beams=12, map_ranges=True, map_evidence=True)
+        assert both.observation_space.shape == (8 + 6 * 12,)  # ranges n, then evidence 2n
+        assert "| 8+3n ... 8+4n-1" in doc

@@ -110,6 +110,109 @@ class PlacementBatch(SensorPlanBatch):
 
 
 class PlacementEnv(SensorPlanEnv):
+    """``sensorplan/Placement-v0``: choose one sensor pose that tells G from H.
+
+    ## Description
+    One decision per episode (a contextual bandit).  A hidden target may stand in a region G
+    or in a region H of a polygonal map; the agent sees the map and picks a sensor placement
+    and aim.  The pose succeeds when it lies in the exact *recognizable region*
+    ``R(G) n R(H) - C(G, H)`` of Briggs & Donald (computed exactly, never sampled, with the
+    placement and aim uncertainties ``eps_pos``/``eps_aim``) and its aim keeps both swept
+    targets in the field of view and range.
+
+    ## Action Space
+    ``action_type="continuous"`` (default): ``Box(-1, 1, (3,), float32)``.
+
+    | Index | Action | Min | Max | Commanded pose (world frame)                           |
+    |-------|--------|-----|-----|--------------------------------------------------------|
+    | 0     | x      | -1  | 1   | ``x_min + (a + 1) / 2 * (x_max - x_min)``, scene units |
+    | 1     | y      | -1  | 1   | ``y_min + (a + 1) / 2 * (y_max - y_min)``, scene units |
+    | 2     | aim    | -1  | 1   | ``pi * a`` radians, counter-clockwise from +x          |
+
+    over the scene's bounding box.  Out-of-range values are clipped; NaN/inf or a wrong shape
+    raise ``ValueError``.  ``action_type="discrete"``: ``Discrete(G * G * A)``, a ``G x G``
+    grid of placements (cell centres) times ``A`` aims ``-pi + 2 pi k / A``, ``a = (i * G +
+    j) * A + k`` for column ``i`` (x), row ``j`` (y), aim ``k``; ``G = placement_grid`` (16),
+    ``A = placement_aims`` (8).  ``env.action_to_pose(a)`` / ``env.pose_to_action(pose)``
+    convert between continuous actions and poses.
+
+    ## Observation Space
+    ``obs_type="vector"`` (default): ``Box(float32, (8 + 2 * n,))``, ``n = n_beams``;
+    constant for a fixed scene (it describes the map, which matters with ``scene="random"``).
+
+    | Index          | Observation                                 | Min | Max | Units / frame     |
+    |----------------|---------------------------------------------|-----|-----|-------------------|
+    | 0, 1           | centre of G (x, y)                          | -1  | 1   | world, scaled (1) |
+    | 2, 3           | centre of H (x, y)                          | -1  | 1   | world, scaled (1) |
+    | 4, 5           | width, height of G's bounding box           | 0   | 1   | / scene's span    |
+    | 6, 7           | width, height of H's bounding box           | 0   | 1   | / scene's span    |
+    | 8 ... 8+n-1    | 360-degree scan of the empty scene from G's | 0   | 1   | / diameter        |
+    |                | centre (n beams evenly spaced, world frame) |     |     |                   |
+    | 8+n ... 8+2n-1 | the same scan from H's centre               | 0   | 1   | / diameter        |
+
+    (1) ``2 (x - x_min) / (x_max - x_min) - 1`` over the scene's bounding box (likewise y).
+    "Scene's span": the bounding box's width (for widths) and height (for heights).  The
+    scans see walls and obstacles only.
+
+    ``obs_type="grid"``: ``Box(uint8, (3, S, S))``, ``S = grid_size`` (default 64), channel
+    first, the bounding box fit into the square (aspect kept), row 0 at the top; channels
+    0 not free (walls, obstacles, outside), 1 G, 2 H.
+
+    ## Rewards
+    ``1`` when the commanded pose distinguishes "target in G" from "target in H" under the
+    configured model: the placement lies in the exact recognizable region and every aim in
+    ``aim +- eps_aim`` keeps the convex hulls of the target swept over G and over H inside the
+    field of view (and within ``max_range``); else ``0``.  Optional shaped term ``-shaping *
+    d / diameter``, ``d`` the distance from the placement to the region (``shaping=0``).
+
+    ## Starting State
+    No pose: the episode is the one decision.  ``reset`` returns the map's observation; with
+    ``scene="random"`` it draws a scene from the pool first.
+
+    ## Episode End
+    * Termination: always, after the single step.
+    * Truncation: never (``max_steps`` is 1; no time limit is registered).
+
+    ``info`` after the step: ``is_success``, ``recognizing`` (same as the 0/1 reward),
+    ``in_region``, ``aim_ok``, ``distance_to_region`` (scene units), ``pose`` (commanded)
+    and ``executed_pose`` (perturbed within ``eps_pos``/``eps_aim``; the beams of the
+    rendered frame are cast from it).
+
+    ## Arguments
+    ```python
+    import gymnasium as gym
+    env = gym.make("sensorplan/Placement-v0", scene="edr", model="partial")
+    envs = gym.make_vec("sensorplan/Placement-v0", num_envs=64, scene="random",
+                        vectorization_mode="vector_entry_point")
+    ```
+
+    Placement's own: ``shaping`` (0.0); with ``action_type="discrete"``, ``placement_grid``
+    (16) and ``placement_aims`` (8).
+    Common to all tasks (details: ``help(sensorplan_gym.envs.base)``):
+
+    * ``scene`` (``"lab"``): a bundled scene (``lab``, ``edr``, ``corridor``, ``warehouse``),
+      a scene JSON path, a dict or ``geometry.Scene``, or ``"random"``: each reset draws from
+      a seeded pool of procedural scenes (``scene_pool_size`` = 64, ``scene_pool_seed`` = 0,
+      ``random_scene_kwargs``; ``min_start_distance``, a fraction of the scene diameter, is
+      the difficulty knob of the robot tasks).
+    * ``model`` (``"complete"`` | ``"partial"``) and ``motion`` (``"stationary"`` |
+      ``"translating"`` | ``"rotating"``): the visibility model and the target's motion in
+      G/H of the recognizable region; unsupported pairs raise ``NotImplementedError``.
+    * ``eps_pos`` (scene units), ``eps_aim`` (radians, in [0, pi)), ``fov_deg`` (degrees),
+      ``max_range`` (scene units; ``math.inf``: unlimited): ``None`` takes the scene's.
+    * ``n_beams`` (16), ``noise`` (0, range std in scene units), ``obs_type`` (``"vector"`` |
+      ``"grid"``), ``grid_size`` (64), ``robot_radius`` (0: a point robot).
+    * ``action_type`` (``"continuous"`` | ``"discrete"``), ``max_steps`` (time limit),
+      ``render_mode`` (``None`` | ``"rgb_array"`` | ``"human"``).
+
+    ## Version History
+    * v0: the initial version.  Added within v0 (defaults keep the earlier behaviour): the
+      batched core, one implementation behind the single env and the native vector env
+      (``vector_entry_point``); ``action_type`` (the discrete placement grid);
+      ``max_steps``; scene pools (``scene="random"``, ``scene_pool_size``,
+      ``scene_pool_seed``).
+    """
+
     batch_cls = PlacementBatch
 
     def action_to_pose(self, a: np.ndarray) -> tuple[float, float, float]:

@@ -209,6 +209,141 @@ def _hidden_target(w) -> dict:
 
 
 class RecognizeEnv(SensorPlanEnv):
+    """``sensorplan/Recognize-v0``: find out whether the hidden target is in G or in H.
+
+    ## Description
+    The EDR recognition problem of Briggs & Donald as a POMDP.  At reset a hidden target is
+    put in G or in H (probability 1/2 each), uniformly in the region (at its centre for
+    ``motion="stationary"``), at orientation 0 or, for ``motion="rotating"``, uniform in
+    [0, 2 pi).  The agent drives and aims its range sensor, whose beams are occluded and
+    reflected by the target like any wall, and ends the episode by declaring G or H.  The
+    exact recognizable region ``R(G) n R(H) - C(G, H)`` is where the readings are guaranteed
+    to tell the two apart.  The target's side and pose are never part of the observation:
+    only the beams it reflects.
+
+    ## Action Space
+    ``action_type="continuous"`` (default): ``Box(-1, 1, (4,), float32)``.
+
+    | Index | Action  | Min | Max | Effect                                                 |
+    |-------|---------|-----|-----|--------------------------------------------------------|
+    | 0     | forward | -1  | 1   | ``max_speed * a`` along the heading (robot frame)      |
+    | 1     | lateral | -1  | 1   | ``max_speed * a`` to the robot's left (robot frame)    |
+    | 2     | turn    | -1  | 1   | ``max_turn * a`` radians, counter-clockwise            |
+    | 3     | decide  | -1  | 1   | ``< -1/3``: point at G, ``> 1/3``: at H, else continue |
+
+    Driving is as in Navigate-v0 (``max_speed`` 3 % of the diameter per step, ``max_turn``
+    pi/8; translate swept against walls, obstacles and the target, then turn).  A label
+    pointed at on ``declare_hold`` consecutive steps (default 1) is declared: the declaring
+    step still moves first, then the declaration ends the episode.  ``declare_hold=3`` or
+    more keeps an exploring policy from ending episodes by accident.  Out-of-range values
+    are clipped; NaN/inf or a wrong shape raise ``ValueError``.  ``action_type="discrete"``:
+    ``Discrete(9)``: 0 stay, 1 forward, 2 backward, 3 left, 4 right, 5 turn left, 6 turn
+    right, 7 point at G, 8 point at H.
+
+    ## Observation Space
+    As Navigate-v0; the hidden target shows only in the beams it reflects.
+
+    ``obs_type="vector"`` (default): ``Box(float32, (8 + 3 * n,))`` with ``n = n_beams``.
+    "World frame": the scene's coordinates (scene units; the bundled scenes are in metres),
+    angles counter-clockwise from +x.  "Robot frame": x forward along the heading ``psi``,
+    y to the robot's left.  ``reach = min(max_range, scene diameter)``.
+
+    | Index           | Observation                               | Min | Max | Units / frame     |
+    |-----------------|-------------------------------------------|-----|-----|-------------------|
+    | 0               | x position                                | -1  | 1   | world, scaled (1) |
+    | 1               | y position                                | -1  | 1   | world, scaled (1) |
+    | 2               | cos(psi), heading psi                     | -1  | 1   | world, radians    |
+    | 3               | sin(psi)                                  | -1  | 1   | world, radians    |
+    | 4, 5            | vector to the centre of G (forward, left) | -1  | 1   | robot, / diameter |
+    | 6, 7            | vector to the centre of H (forward, left) | -1  | 1   | robot, / diameter |
+    | 8 ... 8+n-1     | beam ranges (beam b: the b-th of the fan) | 0   | 1   | / reach           |
+    | 8+n ... 8+2n-1  | surface normal at each hit, x components  | -1  | 1   | robot, unit (2)   |
+    | 8+2n ... 8+3n-1 | surface normal at each hit, y components  | -1  | 1   | robot, unit (2)   |
+    | 8+3n ... 8+4n-1 | ``map_ranges=True``: range the static map | 0   | 1   | / reach (3)       |
+    |                 | predicts for each beam                    |     |     |                   |
+    | next n, next n  | ``map_evidence=True``: beam evidence for  | 0   | 1   | 0/1 flags (4)     |
+    |                 | G (n flags), then for H (n flags)         |     |     |                   |
+
+    (1) ``2 (x - x_min) / (x_max - x_min) - 1`` over the scene's bounding box, clipped.
+    (2) Zero where the beam hit nothing within ``reach``.  The fan: ``n_beams`` beams spread
+    evenly over ``fov_deg`` centred on the heading (``2 pi / n`` apart at 360 degrees); ranges
+    carry Gaussian ``noise`` (std, scene units) and are read from the *executed* sensor pose.
+    (3) From the commanded pose, walls and obstacles only, no noise: what a robot carrying
+    the map expects.  Comes after the normals; ``map_evidence`` entries come last.
+    (4) 1 where the beam read shorter than the map predicts (by more than ``3 noise +
+    1e-3 reach``) and its end point lies in the hull of the target swept over G (resp. H).
+
+    ``obs_type="grid"``: ``Box(uint8, (5, S, S))``, ``S = grid_size`` (default 64), channel
+    first, the scene's bounding box fit into the square (aspect kept), row 0 at the top.
+    Channels: 0 not free (walls, obstacles, outside), 1 G, 2 H, 3 the robot (255 at its cell,
+    128 two cells ahead along its heading), 4 the current beam hit points (255).
+
+    ## Rewards
+    ``-step_cost`` (0.01) every step; ``+1`` for a right declaration, ``-1`` for a wrong
+    one; the step that reaches the time limit without a declaration gets ``-1`` (a timeout
+    counts as wrong; applied by the env itself, so it holds under ``gym.make``, ``make_vec``
+    and direct construction alike).  Optional potential-based shaping for training,
+    ``shaping * (d_before - d_after) / diameter`` with ``d`` the distance to the exact
+    recognizable region (a map quantity: it says nothing about where the target is);
+    ``shaping=0`` by default.
+
+    ## Starting State
+    The robot starts at the scene's ``start`` pose (world frame, radians); when that pose
+    already recognizes or cannot reach the region, at a start drawn once with a fixed
+    generator (free, outside the region, reaching it).  ``random_start=True`` draws such a
+    start at every reset from the env's ``np_random``.  Then the target is hidden as
+    described above (re-drawn up to 20 times to keep clear of the robot).  With
+    ``scene="random"`` each reset draws a scene from the pool first.
+
+    ## Episode End
+    * Termination: a declaration (G or H).
+    * Truncation: ``max_steps`` steps (default 200, also the registered
+      ``max_episode_steps``), with the timeout penalty above.
+
+    ``info``: ``is_success`` (declared and right), ``declared`` (``None``, ``"G"`` or
+    ``"H"``), ``recognizing`` (the pose is in the exact recognizable region with a valid
+    aim), ``distance_to_region`` (scene units), ``collided``, ``pose``; at the end of an
+    episode also ``target_in`` (``"G"`` or ``"H"``): evaluation data, never observed.
+
+    ## Arguments
+    ```python
+    import gymnasium as gym
+    env = gym.make("sensorplan/Recognize-v0", scene="lab", map_ranges=True, declare_hold=3)
+    envs = gym.make_vec("sensorplan/Recognize-v0", num_envs=256, scene="random",
+                        vectorization_mode="vector_entry_point")
+    ```
+
+    Recognize's own: ``step_cost`` (0.01), ``shaping`` (0.0), ``declare_hold`` (1, a positive
+    integer), ``max_speed`` (``None``: 3 % of the diameter per step), ``max_turn`` (pi/8),
+    ``random_start`` (False).  ``map_ranges`` / ``map_evidence`` (False) add the observation
+    entries above (``obs_type="vector"`` only).
+    Common to all tasks (details: ``help(sensorplan_gym.envs.base)``):
+
+    * ``scene`` (``"lab"``): a bundled scene (``lab``, ``edr``, ``corridor``, ``warehouse``),
+      a scene JSON path, a dict or ``geometry.Scene``, or ``"random"``: each reset draws from
+      a seeded pool of procedural scenes (``scene_pool_size`` = 64, ``scene_pool_seed`` = 0,
+      ``random_scene_kwargs``; ``min_start_distance``, a fraction of the scene diameter, is
+      the difficulty knob of the robot tasks).
+    * ``model`` (``"complete"`` | ``"partial"``) and ``motion`` (``"stationary"`` |
+      ``"translating"`` | ``"rotating"``): the visibility model and the target's motion in
+      G/H of the recognizable region; unsupported pairs raise ``NotImplementedError``.
+    * ``eps_pos`` (scene units), ``eps_aim`` (radians, in [0, pi)), ``fov_deg`` (degrees),
+      ``max_range`` (scene units; ``math.inf``: unlimited): ``None`` takes the scene's.
+    * ``n_beams`` (16), ``noise`` (0, range std in scene units), ``obs_type`` (``"vector"`` |
+      ``"grid"``), ``grid_size`` (64), ``robot_radius`` (0: a point robot).
+    * ``action_type`` (``"continuous"`` | ``"discrete"``), ``max_steps`` (time limit),
+      ``render_mode`` (``None`` | ``"rgb_array"`` | ``"human"``).
+
+    ## Version History
+    * v0: the initial version.  Added within v0 (defaults keep the earlier behaviour): the
+      batched core, one implementation behind the single env and the native vector env
+      (``vector_entry_point``); ``action_type``; ``map_ranges`` and ``map_evidence``;
+      ``declare_hold``; potential ``shaping``; ``max_steps``; scene pools
+      (``scene="random"``, ``scene_pool_size``, ``scene_pool_seed``,
+      ``min_start_distance``); a drawn start when a fixed scene's own start already
+      recognizes.
+    """
+
     batch_cls = RecognizeBatch
 
     @property
