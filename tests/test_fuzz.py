@@ -27,8 +27,9 @@ from geometry.fuzz import check_scene, fuzz_scene, run_many
 #: hull edge whose wedge was pruned by an exact-zero side test (unsafe complete region);
 #: 100833, 2424114 -- GEOS overlays misfiring on a region whose hole touches its shell (the
 #: checker confirms areas by point tests); 102667 -- a ring twisted by the rounding of the
-#: mapping back at a 3.2e5 offset, repaired losing a loop (now kept).
-REGRESSION_SEEDS = [27, 37, 223, 440, 481, 496, 100833, 102667, 2424114]
+#: mapping back at a 3.2e5 offset (302211, 309618: holes; now snap-rounded onto the world's
+#: grid before mapping); 106185 -- GEOS buffer disc sums cutting into the disc.
+REGRESSION_SEEDS = [27, 37, 223, 440, 481, 496, 100833, 102667, 106185, 302211, 309618, 2424114]
 
 
 def _assert_clean(seed: int, swept: bool = False) -> None:
