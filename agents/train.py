@@ -196,8 +196,8 @@ def check_algo_env(algo: str, env_id: str, env_kwargs: dict) -> None:
     if algo == "dqn" and not isinstance(space, gym.spaces.Discrete):
         raise ValueError(
             f"DQN needs a Discrete action space, but {env_id} has {space} (continuous). "
-            "Make the env with discrete actions (--env-kwargs '{\"action_type\": "
-            "\"discrete\"}', as agents/configs/dqn.yaml does) or use ppo, a2c, sac or td3."
+            'Make the env with discrete actions (--env-kwargs \'{"action_type": '
+            '"discrete"}\', as agents/configs/dqn.yaml does) or use ppo, a2c, sac or td3.'
         )
     if algo in ("sac", "td3") and not isinstance(space, gym.spaces.Box):
         raise ValueError(

@@ -357,9 +357,7 @@ def _sorted_gaps(
     return owner, start[owner] + lo_r[owner, col], start[owner] + hi_r[owner, col]
 
 
-def _first_hits(
-    dom: Domain, q: np.ndarray, phi: np.ndarray, *, brute: bool = False
-) -> np.ndarray:
+def _first_hits(dom: Domain, q: np.ndarray, phi: np.ndarray, *, brute: bool = False) -> np.ndarray:
     """Index of the first segment hit by rays from ``q`` (one point or one per
     ray) at angles ``phi``.
 
