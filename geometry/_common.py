@@ -293,6 +293,16 @@ def check_eps(name: str, value: float) -> float:
     return v
 
 
+def check_tol(tol: float | None) -> float | None:
+    """Validate an optional positive tolerance (scene units); ``None`` stays ``None``."""
+    if tol is None:
+        return None
+    tol = check_eps("tol", tol)
+    if tol <= 0:
+        raise ValueError(f"tol must be > 0, got {tol!r}")
+    return tol
+
+
 def shrink_for_position(
     region: shapely.Geometry, allowed: shapely.Geometry, eps_pos: float
 ) -> shapely.Geometry:

@@ -35,6 +35,7 @@ from ._common import (
     check_eps_pos,
     check_pose,
     check_theta,
+    check_tol,
     polygonal,
     scene_domain,
     shrink_for_position,
@@ -115,10 +116,7 @@ def partial_region(
     target_at = check_pose(target_at)
     eps_pos = check_eps_pos(scene, eps_pos)
     eps_aim = check_aim(eps_aim)
-    if tol is not None:
-        tol = check_eps("tol", tol)
-        if tol <= 0:
-            raise ValueError(f"tol must be > 0, got {tol!r}")
+    tol = check_tol(tol)
     budget = Budget.make(timeout, progress, "partial_region(target_in=...)")
     if target_in is None and (timeout is not None or progress is not None):
         raise ValueError("timeout and progress apply to a moving target (target_in=...) only")

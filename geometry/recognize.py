@@ -33,9 +33,9 @@ from ._common import (
     _triangles,
     as_scene,
     check_aim,
-    check_eps,
     check_eps_pos,
     check_theta,
+    check_tol,
     polygonal,
     scene_domain,
     shrink_for_position,
@@ -100,10 +100,7 @@ def recognizable_region(
     theta = check_theta(theta)
     eps_pos = check_eps_pos(scene, eps_pos)
     eps_aim = check_aim(eps_aim)
-    if tol is not None:
-        tol = check_eps("tol", tol)
-        if tol <= 0:
-            raise ValueError(f"tol must be > 0, got {tol!r}")
+    tol = check_tol(tol)
     budget = Budget.make(timeout, progress, "recognizable_region(model='partial')")
     fr = scene.frame
     with world_messages(fr):
