@@ -260,7 +260,7 @@ class _Driver:
         pts = np.stack([x + dist * np.cos(ang), y + dist * np.sin(ang)], axis=1)[hit]
         if len(pts) == 0:
             return
-        tol = max(3.0 * env.sensor.noise, w.eps_pos, 1e-6 * w.diameter) + 1e-3 * w.diameter
+        tol = max(3.0 * env.sensor.noise, w.eps_pos, w.range_acc) + 1e-3 * w.diameter
         static = shapely.distance(shapely.points(pts), w.scene.free_space.boundary)
         self.points.extend(pts[static > tol])
 
@@ -272,7 +272,7 @@ class _Driver:
         self.n_classified = n
         w = self.env.world
         pts = np.asarray(self.points) if self.points else np.empty((0, 2))
-        tol = max(3.0 * self.env.sensor.noise, w.eps_pos, 1e-6 * w.diameter)
+        tol = max(3.0 * self.env.sensor.noise, w.eps_pos, w.range_acc)
         if w.theta is None:  # orientation unknown: a coarser search over the circle
             tau = max(0.15 * w.target_radius, 2.5 * tol)
             res = tau / 2

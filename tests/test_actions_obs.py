@@ -171,3 +171,30 @@ def test_map_evidence_points_at_the_right_region():
             if term or trunc:
                 break
     assert right >= 4
+
+
+def test_noise_is_bounded_and_the_region_allows_for_it():
+    """Range noise is a Gaussian truncated at 3 std (a sensor accurate to a known bound), and
+    the world's region is computed for that accuracy (confusability allows for it)."""
+    from sensorplan_gym.core.sensor import NOISE_BOUND
+
+    sigma = 0.2
+    noisy = gym.make("sensorplan/Navigate-v0", noise=sigma)
+    clean = gym.make("sensorplan/Navigate-v0")
+    w = noisy.unwrapped.world
+    assert w.range_acc == pytest.approx(NOISE_BOUND * sigma)
+    assert clean.unwrapped.world.range_acc == pytest.approx(1e-6 * w.diameter)
+    noisy.reset(seed=0)
+    clean.reset(seed=0)
+    diffs = []
+    for _ in range(60):
+        a = np.array([0.3, 0.2, 0.4], dtype=np.float32)
+        noisy.step(a)
+        clean.step(a)
+        d_n = noisy.unwrapped.scan[0]
+        d_c = clean.unwrapped.scan[0]
+        hit = noisy.unwrapped.scan[2] & (d_c < w.reach) & (d_n < w.reach)
+        diffs.append(np.abs(d_n - d_c)[hit & (d_n > 0)])
+    diffs = np.concatenate(diffs)
+    assert diffs.max() <= NOISE_BOUND * sigma + 1e-12
+    assert diffs.max() > 2 * sigma  # the tails are there, cut at the bound

@@ -8,9 +8,11 @@ present, the target's edges -- and the unit surface normal there, turned to face
 the sensor.  A beam that hits nothing within ``max_range`` returns
 ``max_range`` and a zero normal.  The sensor does not say *what* it hit.
 
-Optional Gaussian noise (standard deviation ``noise``, scene units) is added to
-the hit distances, which are then clipped to ``[0, max_range]``; normals are
-noise-free.
+Optional Gaussian noise (standard deviation ``noise``, scene units, truncated at
+``NOISE_BOUND = 3`` standard deviations, so a reading is accurate to within ``3 noise``) is
+added to the hit distances, which are then clipped to ``[0, max_range]``; normals are
+noise-free.  The environments compute their regions for a sensor whose range accuracy is at
+most that bound (``WorldConfig.range_acc``; the scene's ``sensor.range_acc`` when larger).
 
 :func:`cast_batch` is the one implementation: N sensors x B beams x M segments, the inner
 loop in :func:`.kernels.cast` (compiled with numba when the ``fast`` extra is
@@ -133,12 +135,19 @@ def beam_offsets(n_beams: int, fov: float) -> np.ndarray:
     return np.linspace(-fov / 2, fov / 2, n_beams)
 
 
+#: range noise is a Gaussian truncated at this many standard deviations: a reading is within
+#: ``NOISE_BOUND * noise`` of the true distance (the paper's sensor is accurate to a known bound)
+NOISE_BOUND = 3.0
+
+
 def add_noise(dist, hit, z, noise, max_range):
-    """``dist + noise * z`` on the beams that hit, clipped to ``[0, max_range]``."""
+    """``dist + noise * z`` on the beams that hit, ``z`` truncated to ``+-NOISE_BOUND``,
+    clipped to ``[0, max_range]``."""
     mr = np.asarray(max_range)
     if mr.ndim:
         mr = mr[:, None]
+    z = np.clip(z, -NOISE_BOUND, NOISE_BOUND)
     return np.clip(dist + np.where(hit, noise * z, 0.0), 0.0, mr)
 
 
-__all__ += ["add_noise", "beam_offsets"]
+__all__ += ["NOISE_BOUND", "add_noise", "beam_offsets"]

@@ -32,6 +32,7 @@ carrying the geometry's message.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -95,13 +96,16 @@ class WorldConfig:
     fov: float | None = None
     max_range: float | None = None
     robot_radius: float = 0.0
+    #: the range accuracy the simulated sensor needs (scene units): the region is computed for
+    #: a sensor no more accurate than this (``None``: the scene's ``sensor.range_acc``)
+    range_acc: float | None = None
 
     def validate(self) -> WorldConfig:
         if self.model not in MODELS:
             raise ValueError(f"model must be one of {MODELS}, got {self.model!r}")
         if self.motion not in MOTIONS:
             raise ValueError(f"motion must be one of {MOTIONS}, got {self.motion!r}")
-        for name in ("eps_pos", "eps_aim", "fov", "max_range"):
+        for name in ("eps_pos", "eps_aim", "fov", "max_range", "range_acc"):
             v = getattr(self, name)
             if v is not None and (not isinstance(v, (int, float)) or math.isnan(v) or v < 0):
                 raise ValueError(f"{name} must be a non-negative number or None, got {v!r}")
@@ -128,7 +132,11 @@ class World:
             scene = scene.replace(
                 goal=[list(_anchor(scene.goal_geom))], failure=[list(_anchor(scene.failure_geom))]
             )
+        if cfg.range_acc is not None and cfg.range_acc > scene.range_acc:
+            # the readings are only this accurate: confusability is judged with that bound
+            scene = scene.replace(sensor=dataclasses.replace(scene.sensor, range_acc=cfg.range_acc))
         self.scene = scene
+        self.range_acc = float(scene.range_acc)
         self.theta: float | None = None if cfg.motion == "rotating" else 0.0
         self.eps_pos = float(sensor.eps_pos if cfg.eps_pos is None else cfg.eps_pos)
         self.eps_aim = float(sensor.eps_aim if cfg.eps_aim is None else cfg.eps_aim)

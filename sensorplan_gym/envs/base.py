@@ -28,7 +28,9 @@ eps_aim : float | None -- aim uncertainty in **radians**; ``None``: the scene's.
 fov_deg : float | None -- field of view in degrees; ``None``: the scene's.
 max_range : float | None -- sensor range; ``None``: the scene's; ``math.inf``: unlimited.
 n_beams : int, default 16 -- beams in the sensor's fan (and in Placement's scans).
-noise : float, default 0 -- std of Gaussian range noise (scene units).
+noise : float, default 0 -- std of Gaussian range noise (scene units), truncated at 3 std:
+    the recognizable region is computed for a sensor accurate to ``max(3 noise, the scene's
+    sensor.range_acc)`` (paper section 2), so confusability allows for the noise.
 obs_type : ``"vector"`` (default) | ``"grid"`` (see :mod:`sensorplan_gym.core.observations`).
 grid_size : int, default 64 -- side of the grid observation.
 robot_radius : float, default 0 -- the robot is a disc of this radius (0: a point).
@@ -67,7 +69,7 @@ from ..core.actions import make_actions
 from ..core.observations import make_observation
 from ..core.pool import FixedScene, shared_pool
 from ..core.rendering import HumanViewer, Renderer
-from ..core.sensor import RangeSensor
+from ..core.sensor import NOISE_BOUND, RangeSensor
 from ..core.sim import BLOCK, BatchSim
 from ..core.world import World, WorldConfig, get_world, load_scene
 
@@ -217,6 +219,7 @@ class SensorPlanBatch(BatchSim):
             fov=None if fov_deg is None else math.radians(float(fov_deg)),
             max_range=None if max_range is None else float(max_range),
             robot_radius=float(robot_radius),
+            range_acc=NOISE_BOUND * float(noise) if noise > 0 else None,
         ).validate()
         super().__init__(n, n_beams, noise, robot_radius)
         unknown = set(action_kw) - {"placement_grid", "placement_aims"}
