@@ -93,8 +93,10 @@ def benchmark(
     env_kwargs: dict | None = None,
     out: str | Path | None = None,
     verbose: bool = True,
+    deterministic: bool = True,
 ) -> dict[str, Any]:
-    """Evaluate ``policies`` on every split; returns ``{"splits": {name: results}, "rows":
+    """Evaluate ``policies`` on every split (``deterministic=False``: trained models sample
+    their actions); returns ``{"splits": {name: results}, "rows":
     [...]}`` (one row per split and policy) and writes benchmark.json / .csv to ``out``."""
     import gymnasium as gym
 
@@ -114,6 +116,7 @@ def benchmark(
         "difficulty": {"min_start_distance": difficulty if needs_start else None},
         "episodes": episodes,
         "seed": seed,
+        "deterministic": bool(deterministic),
         "splits": {},
         "rows": [],
     }
@@ -130,6 +133,7 @@ def benchmark(
             env_kwargs=kw,
             out=out / name.replace(":", "_"),
             verbose=verbose,
+            deterministic=deterministic,
         )
         r["start_distance"] = _start_distance(env_id, kw, seeds)
         res["splits"][name] = r

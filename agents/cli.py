@@ -157,6 +157,11 @@ def build_parser() -> argparse.ArgumentParser:
         help="ray: play the episodes on Ray workers (same results as local; agents.ray_eval)",
     )
     e.add_argument("--address", default=None, help="ray: an existing Ray cluster's address")
+    e.add_argument(
+        "--stochastic",
+        action="store_true",
+        help="trained models sample their actions (default: deterministic)",
+    )
 
     bm = sub.add_parser(
         "benchmark",
@@ -174,13 +179,18 @@ def build_parser() -> argparse.ArgumentParser:
         "--difficulty",
         type=float,
         default=None,
-        help="min_start_distance of the procedural splits, in scene diameters (default 0.4)",
+        help="min_start_distance of the procedural splits, in scene diameters (default 0.35)",
     )
     bm.add_argument(
         "--splits", nargs="+", default=None, help="train, test, ood, ood:<scene> (default: all)"
     )
     bm.add_argument("--env-kwargs", type=_json_dict, default=None)
     bm.add_argument("--out", default=None, help="output folder (default runs/benchmark_<env>)")
+    bm.add_argument(
+        "--stochastic",
+        action="store_true",
+        help="trained models sample their actions (default: deterministic)",
+    )
 
     sub.add_parser(
         "demo", help="the paper's surveillance scenario end to end (agents.demo)", add_help=False
@@ -211,6 +221,7 @@ def build_parser() -> argparse.ArgumentParser:
 EXTRA_OF_MODULE = {
     "yaml": "rl",
     "stable_baselines3": "rl",
+    "sb3_contrib": "rl",
     "torch": "rl",
     "tqdm": "rl",
     "rich": "rl",
@@ -344,6 +355,7 @@ def main(argv: list[str] | None = None) -> int:
                 split_names=args.splits,
                 env_kwargs=args.env_kwargs,
                 out=args.out,
+                deterministic=not args.stochastic,
             )
             return 0
         if args.command == "evaluate":
@@ -359,6 +371,7 @@ def main(argv: list[str] | None = None) -> int:
                 plot=not args.no_plot,
                 backend=args.backend,
                 address=args.address,
+                deterministic=not args.stochastic,
             )
             return 0
     except ImportError as err:

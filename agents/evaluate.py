@@ -6,7 +6,15 @@
 Every policy plays the same ``N`` episodes, reset with seeds ``1_000_000 + S + i``
 (``i = 0 .. N-1``): disjoint from the training seeds (``S .. S + n_envs - 1``) and from the
 periodic-evaluation seed (``S + 10_000``) of :mod:`agents.train`.  Trained models act
-deterministically.
+deterministically, or with ``deterministic=False`` (``--stochastic``) sample their actions
+(torch seeded with ``S`` before each policy, so a stochastic evaluation repeats exactly).
+
+When the episodes replay one fixed scene from one fixed start (a bundled scene without
+``random_start``), a deterministic policy plays nearly the same episode each time: only the
+target's side and place and the pose noise vary.  The episodes are then not independent
+samples of the policy's skill, the Wilson interval is too narrow, and the results carry
+``independent_episodes: false`` and a printed note; the interval across training seeds (IQM)
+is the honest one.
 
 Per policy: success rate (``info["is_success"]`` at the episode's last step) with its 95%
 Wilson interval, mean return, mean steps, mean path length (the sum of the position changes
@@ -215,12 +223,15 @@ def evaluate(
     threads: int | None = 1,
     backend: str = "local",
     address: str | None = None,
+    deterministic: bool = True,
 ) -> dict[str, Any]:
     """Evaluate each policy spec (``"oracle"``, ``"random"``, a model zip) for ``episodes``
     episodes of ``env_id`` made with ``env_kwargs``; returns the results dict and, unless
     ``out`` is ``False``, writes results.json / results.csv / results.png there.
     ``backend="ray"`` plays the episodes on Ray workers (:mod:`agents.ray_eval`; a local
-    instance, or the cluster at ``address``) with results identical to ``"local"``."""
+    instance, or the cluster at ``address``) with results identical to ``"local"``.
+    ``deterministic=False``: trained models sample their actions (torch seeded with ``seed``
+    before each policy)."""
     if backend not in ("local", "ray"):
         raise ValueError(f"backend must be 'local' or 'ray', got {backend!r}")
     import gymnasium as gym
@@ -245,11 +256,14 @@ def evaluate(
     env_kwargs = dict(env_kwargs or {})
     seeds = [EVAL_SEED_BASE + seed + i for i in range(episodes)]
     names = _unique([policy_label(p) for p in policies])
+    fixed = env_kwargs.get("scene", "lab") != "random" and not env_kwargs.get("random_start")
     results: dict[str, Any] = {
         "env_id": env_id,
         "env_kwargs": env_kwargs,
         "episodes": episodes,
         "seed": seed,
+        "deterministic": bool(deterministic),
+        "independent_episodes": not fixed,
         "episode_seeds": [seeds[0], seeds[-1]],
         "policies": [],
         "iqm": {},
@@ -282,12 +296,24 @@ def evaluate(
                 if diff and verbose:
                     print(f"note: {name} was trained with env kwargs {diff} (trained, evaluated)")
             t0 = time.perf_counter()
+            if meta["kind"] == "model":
+                import torch
+
+                torch.manual_seed(seed)  # stochastic actions repeat exactly
             if backend == "ray":
                 from .ray_eval import run_episodes_ray
 
-                ep = run_episodes_ray(env_id, env_kwargs, spec, seeds, seed=seed, address=address)
+                ep = run_episodes_ray(
+                    env_id,
+                    env_kwargs,
+                    spec,
+                    seeds,
+                    seed=seed,
+                    address=address,
+                    deterministic=deterministic,
+                )
             else:
-                ep = run_episodes(env, policy, seeds)
+                ep = run_episodes(env, policy, seeds, deterministic=deterministic)
             meta["backend"] = backend
             meta["eval_time_s"] = round(time.perf_counter() - t0, 2)
         finally:
@@ -377,6 +403,14 @@ def evaluate(
             f"{seeds[0]}..{seeds[-1]}"
         )
         print(format_table(results))
+        if not deterministic:
+            print("trained models sampled their actions (stochastic evaluation)")
+        if fixed:
+            print(
+                "note: every episode starts from the scene's fixed start, so a deterministic "
+                "policy replays nearly one episode; the Wilson intervals treat them as "
+                "independent and are too narrow -- compare training seeds (IQM) instead"
+            )
         if results["files"]:
             print("wrote " + ", ".join(results["files"].values()))
     return results

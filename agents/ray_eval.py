@@ -85,7 +85,11 @@ def _gym_chunk(job: dict[str, Any], spec: str, seeds: list[int]) -> dict[str, li
     env = gym.make(job["env_id"], **job["env_kwargs"])
     try:
         policy = load_policy(spec, env, seed=job["seed"])
-        return run_episodes(env, policy, seeds)
+        if spec not in ("oracle", "random"):
+            import torch
+
+            torch.manual_seed(job["seed"])
+        return run_episodes(env, policy, seeds, deterministic=job.get("deterministic", True))
     finally:
         env.close()
 
@@ -99,11 +103,17 @@ def run_episodes_ray(
     seed: int = 0,
     chunk: int = 25,
     address: str | None = None,
+    deterministic: bool = True,
 ) -> dict[str, list]:
     """The per-episode results of policy ``spec`` on ``env_id`` for ``seeds``, as
     :func:`agents.evaluate.run_episodes` gives them, computed on Ray workers.  A model zip
     path must be readable from the workers (same path on every node)."""
-    job = {"env_id": env_id, "env_kwargs": dict(env_kwargs), "seed": int(seed)}
+    job = {
+        "env_id": env_id,
+        "env_kwargs": dict(env_kwargs),
+        "seed": int(seed),
+        "deterministic": bool(deterministic),
+    }
     # the random baseline's generator runs on across episodes: one task keeps its sequence
     size = len(seeds) if spec == "random" else chunk
     return map_chunks(_gym_chunk, [job], spec, seeds, chunk=max(1, size), address=address)[0]

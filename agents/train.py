@@ -10,7 +10,11 @@ constructor arguments plus these keys:
 ``n_timesteps``, ``n_envs``, ``policy`` (default ``MlpPolicy``), ``env_kwargs`` (passed to
 ``gym.make``), ``eval_freq`` (environment steps between evaluations, all envs together),
 ``n_eval_episodes``; ``policy_kwargs.activation_fn`` is a name (``tanh``, ``relu``, ...);
-``action_noise: {type: normal|ornstein-uhlenbeck, sigma: s}`` for off-policy algorithms.
+``action_noise: {type: normal|ornstein-uhlenbeck, sigma: s}`` for off-policy algorithms;
+``frame_stack: k`` (SB3's ``VecFrameStack``: the policy sees the last ``k`` observations,
+a memory for partially observable tasks); ``normalize: true`` or ``{norm_obs: ..,
+norm_reward: ..}`` (SB3's ``VecNormalize``; its statistics are saved beside each model as
+``<model>_vecnormalize.pkl`` and :func:`agents.policies.load_policy` applies them).
 
 Command-line values override the file (``--env-kwargs`` is merged over ``env_kwargs``).
 ``--config FILE`` reads another file of the same layout, or a section on its own, or the
@@ -70,6 +74,8 @@ _META_KEYS = (
     "eval_freq",
     "n_eval_episodes",
     "vec_env",
+    "frame_stack",
+    "normalize",
 )
 
 
@@ -193,9 +199,9 @@ def check_algo_env(algo: str, env_id: str, env_kwargs: dict) -> None:
         space = env.action_space
     finally:
         env.close()
-    if algo == "dqn" and not isinstance(space, gym.spaces.Discrete):
+    if algo in ("dqn", "qrdqn") and not isinstance(space, gym.spaces.Discrete):
         raise ValueError(
-            f"DQN needs a Discrete action space, but {env_id} has {space} (continuous). "
+            f"{algo.upper()} needs a Discrete action space, but {env_id} has {space} (continuous). "
             'Make the env with discrete actions (--env-kwargs \'{"action_type": '
             '"discrete"}\', as agents/configs/dqn.yaml does) or use ppo, a2c, sac or td3.'
         )
@@ -204,6 +210,28 @@ def check_algo_env(algo: str, env_id: str, env_kwargs: dict) -> None:
             f"{algo.upper()} needs a continuous (Box) action space; {env_id} has {space} "
             "(drop action_type='discrete')"
         )
+
+
+def _save_vecnormalize(model, model_path: Path) -> None:
+    """Save the model's ``VecNormalize`` statistics (if it trains with one) beside it."""
+    from .policies import vecnormalize_path
+
+    vn = model.get_vec_normalize_env()
+    if vn is not None:
+        vn.save(str(vecnormalize_path(model_path)))
+
+
+def _normalize_kwargs(spec: Any, gamma: Any) -> dict | None:
+    """``VecNormalize`` keyword arguments for the ``normalize`` config key (``None``: off)."""
+    if not spec:
+        return None
+    kw: dict[str, Any] = {} if spec is True else dict(spec)
+    unknown = set(kw) - {"norm_obs", "norm_reward", "clip_obs", "clip_reward", "gamma"}
+    if unknown:
+        raise ValueError(f"normalize: unknown keys {sorted(unknown)}")
+    if gamma is not None:
+        kw.setdefault("gamma", float(gamma))
+    return kw
 
 
 def _eval_callback_cls():
@@ -229,6 +257,7 @@ def _eval_callback_cls():
                 if key > self.best_key:
                     self.best_key = key
                     self.model.save(self.best_path)
+                    _save_vecnormalize(self.model, self.best_path)
                     self.best_info = {
                         "timesteps": int(self.num_timesteps),
                         "success_rate": sr,
@@ -320,6 +349,10 @@ def train(
         raise ValueError(f"vec_env must be one of {', '.join(VEC_ENVS)}, got {vec_env!r}")
     if n_envs < 1 or n_timesteps < 1:
         raise ValueError("--n-envs and --timesteps must be positive")
+    frame_stack = int(hp.pop("frame_stack", 1) or 1)
+    if frame_stack < 1:
+        raise ValueError(f"frame_stack must be a positive integer, got {frame_stack}")
+    norm_kw = _normalize_kwargs(hp.pop("normalize", None), hp.get("gamma"))
     hyperparams = copy.deepcopy(hp)  # as written in the YAML, for the record
 
     out = Path(out) if out is not None else default_out(algo, env_id, seed)
@@ -344,6 +377,24 @@ def train(
         venv = make_vec_env(make, n_envs=n_envs, seed=seed, vec_env_cls=vec_cls)
         vec_name = vec_cls.__name__
     eval_env = make_vec_env(make, n_envs=1, seed=seed + EVAL_SEED_OFFSET, vec_env_cls=DummyVecEnv)
+    if norm_kw is not None:
+        from stable_baselines3.common.vec_env import VecMonitor, VecNormalize
+
+        if vec_env == "batched":  # wrapped like the training env, so the statistics sync
+            eval_env.close()
+            eval_env = DummyVecEnv([make])
+            eval_env.seed(seed + EVAL_SEED_OFFSET)
+            eval_env = VecMonitor(eval_env)
+        venv = VecNormalize(venv, **norm_kw)
+        # the evaluation env uses the training statistics (EvalCallback syncs them), frozen
+        eval_env = VecNormalize(eval_env, training=False, norm_reward=False, **{
+            k: v for k, v in norm_kw.items() if k not in ("norm_reward",)
+        })
+    if frame_stack > 1:
+        from stable_baselines3.common.vec_env import VecFrameStack
+
+        venv = VecFrameStack(venv, frame_stack)
+        eval_env = VecFrameStack(eval_env, frame_stack)
 
     kwargs = dict(hp)
     pk = dict(kwargs.pop("policy_kwargs", None) or {})
@@ -355,6 +406,12 @@ def train(
         kwargs["action_noise"] = _action_noise(kwargs["action_noise"], venv.action_space)
     if tensorboard is None:
         tensorboard = importlib.util.find_spec("tensorboard") is not None
+        if not tensorboard and verbose:
+            print(
+                "note: tensorboard is not installed, so no TensorBoard logs are written "
+                "(pip install 'sensorplan-gym[rl]' installs it; --no-tensorboard hides this)",
+                flush=True,
+            )
     if tensorboard:
         kwargs["tensorboard_log"] = str(out / "tb")
     if progress_bar is None:
@@ -365,6 +422,9 @@ def train(
         "env_id": env_id,
         "env_kwargs": resolved_env_kwargs,
         "policy": policy,
+        "frame_stack": frame_stack,
+        "normalize": norm_kw is not None,
+        "normalize_kwargs": norm_kw,
         "hyperparams": hyperparams,
         "seed": int(seed),
         "timesteps": n_timesteps,
@@ -421,6 +481,17 @@ def train(
             raise FileNotFoundError(f"--resume: no saved model at {resume}")
         model = algo_class(algo).load(resume, env=venv, device=device)
         model.set_random_seed(seed)
+        if norm_kw is not None:
+            from .policies import vecnormalize_path
+
+            stats = vecnormalize_path(resume)
+            if stats.is_file():  # carry on with the saved statistics
+                import pickle
+
+                with open(stats, "rb") as f:
+                    saved = pickle.load(f)
+                venv_norm = model.get_vec_normalize_env()
+                venv_norm.obs_rms, venv_norm.ret_rms = saved.obs_rms, saved.ret_rms
     else:
         model = algo_class(algo)(
             policy, venv, seed=seed, verbose=0 if verbose < 2 else 1, device=device, **kwargs
@@ -472,9 +543,11 @@ def train(
     train_time = time.perf_counter() - t0
     record["train_time_s"] = round(train_time, 1)
     model.save(out / "final_model.zip")
+    _save_vecnormalize(model, out / "final_model.zip")
     write_config(out / "final_model.yaml")
     if callback.best_info is None:  # no evaluation ran (short run): the final model is the best
         shutil.copyfile(out / "final_model.zip", out / "best_model.zip")
+        _save_vecnormalize(model, out / "best_model.zip")
         write_config(
             out / "best_model.yaml",
             {"timesteps": int(model.num_timesteps), "success_rate": None, "mean_return": None},
