@@ -9,7 +9,9 @@ second watch spot H, and a start like TOMMY's from which neither can be watched)
    obstacles when no one-step motion exists);
 3. the oracle drives there in ``Recognize-v0`` (a hidden target stands in G or H),
    reads the simulated range sensor, and declares G or H from the readings;
-4. oracle vs the shipped PPO policies vs random on ``Navigate-v0`` (lab): a table.
+4. oracle vs the shipped PPO policies vs random on ``Navigate-v0`` (lab): a table;
+5. oracle vs the shipped PPO policy for the EDR task (trained on procedural scenes, never
+   on ``lab``) vs random on ``Recognize-v0`` (lab, random starts): a table.
 
 Figures and the evaluation files go to the folder given by ``--out`` (default
 ``sensorplan-demo``); the path is printed.
@@ -39,8 +41,10 @@ The paper's surveillance scenario end to end (section 6), on the bundled 'lab' s
      placement, the aim and the motion to it (Figure 16);
   3. the oracle drives there in Recognize-v0 and declares G or H from its range readings;
   4. oracle vs the shipped PPO policies vs random on Navigate-v0 (lab): a table.
+  5. oracle vs the shipped PPO policy for the EDR task (trained on procedural scenes,
+     never on lab) vs random on Recognize-v0 (lab, random starts): a table.
      The PPO policies need the rl extra (pip install -e ".[rl]"); without it the
-     table has oracle and random only.
+     tables have oracle and random only.
 
 Figures and evaluation files go to --out (default: sensorplan-demo)."""
 
@@ -48,6 +52,15 @@ PRETRAINED = [
     Path(__file__).parent / "pretrained" / "ppo_navigate_lab.zip",
     Path(__file__).parent / "pretrained" / "ppo_navigate_lab_random_start.zip",
 ]
+#: the shipped Recognize-v0 policy (trained on procedural scenes) and the env it plays
+PRETRAINED_RECOGNIZE = Path(__file__).parent / "pretrained" / "ppo_recognize_random.zip"
+RECOGNIZE_KWARGS = {
+    "scene": "lab",
+    "map_ranges": True,
+    "map_evidence": True,
+    "declare_hold": 3,
+    "random_start": True,
+}
 
 
 def merge_short_legs(path: np.ndarray, min_len: float) -> np.ndarray:
@@ -255,6 +268,22 @@ def _recognize(out: Path, seed: int) -> tuple[str, str, int]:
     return info.get("target_in", "?"), info.get("declared") or "none", steps
 
 
+def _shipped(paths: list[Path]) -> list[str]:
+    """The shipped policy files of ``paths`` that exist and can be loaded (the rl extra);
+    says why when none can."""
+    missing = [m for m in RL_MODULES if importlib.util.find_spec(m) is None]
+    if missing:
+        print(
+            f"   (the shipped PPO policies need the rl extra -- missing {', '.join(missing)}; "
+            f'install it with: pip install -e ".[rl]"; evaluating oracle and random only)'
+        )
+        return []
+    found = [str(p) for p in paths if p.exists()]
+    if not found:
+        print("   (no shipped policy found; evaluating oracle and random only)")
+    return found
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the demo; returns a process exit code."""
     ap = argparse.ArgumentParser(
@@ -323,17 +352,7 @@ def main(argv: list[str] | None = None) -> int:
     print(f"4. Navigate-v0 (lab), {args.episodes} episodes per policy:")
     from .evaluate import evaluate, format_table
 
-    policies = ["oracle", "random"]
-    missing = [m for m in RL_MODULES if importlib.util.find_spec(m) is None]
-    if missing:
-        print(
-            f"   (the shipped PPO policies need the rl extra -- missing {', '.join(missing)}; "
-            f'install it with: pip install -e ".[rl]"; evaluating oracle and random only)'
-        )
-    else:
-        policies += [str(p) for p in PRETRAINED if p.exists()]
-        if len(policies) == 2:
-            print("   (no shipped policy found; evaluating oracle and random only)")
+    policies = ["oracle", "random"] + _shipped(PRETRAINED)
     res = evaluate(
         "sensorplan/Navigate-v0",
         policies,
@@ -341,6 +360,21 @@ def main(argv: list[str] | None = None) -> int:
         seed=args.seed,
         env_kwargs={"scene": "lab"},
         out=out / "navigate_eval",
+        verbose=False,
+    )
+    print(format_table(res))
+
+    print(
+        f"5. Recognize-v0 (lab, random starts), {args.episodes} episodes per policy "
+        "(the PPO policy was trained on procedural scenes, never on lab):"
+    )
+    res = evaluate(
+        "sensorplan/Recognize-v0",
+        ["oracle", "random"] + _shipped([PRETRAINED_RECOGNIZE]),
+        episodes=args.episodes,
+        seed=args.seed,
+        env_kwargs=RECOGNIZE_KWARGS,
+        out=out / "recognize_eval",
         verbose=False,
     )
     print(format_table(res))

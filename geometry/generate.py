@@ -135,6 +135,7 @@ def random_scene(
     margin: float = 0.05,
     name: str = "random",
     max_tries: int = 200,
+    fov_deg: float | tuple[float, float] | None = None,
 ) -> dict[str, Any]:
     """A random scene dict in the pinned JSON format.
 
@@ -158,11 +159,22 @@ def random_scene(
     margin : clearance (scene units) kept between obstacles, walls and the hulls.
     name : the scene's ``name``.
     max_tries : re-sampling budget before giving up with ``RuntimeError``.
+    fov_deg : the sensor's field of view in degrees, written as ``sensor.fov_deg``: a number,
+        or ``(low, high)`` to draw it uniformly (one draw from ``rng`` after the geometry,
+        so the geometry is the same as without it).  ``None`` (default): no ``sensor`` key
+        (the 360-degree default sensor).
 
     Returns
     -------
-    dict with keys ``name, bounds, obstacles, target, goal, failure``.
+    dict with keys ``name, bounds, obstacles, target, goal, failure`` (and ``sensor`` when
+    ``fov_deg`` is given).
     """
+    if fov_deg is not None:
+        lo_hi = (fov_deg, fov_deg) if np.isscalar(fov_deg) else tuple(fov_deg)
+        if len(lo_hi) != 2 or not all(0 < float(v) <= 360 for v in lo_hi) or lo_hi[0] > lo_hi[1]:
+            raise ValueError(
+                f"fov_deg must be a number in (0, 360] or a (low, high) pair of them, got {fov_deg!r}"
+            )
     failure = failure or goal
     for _ in range(max_tries):
         d = _try_scene(
@@ -183,6 +195,9 @@ def random_scene(
             name=name,
         )
         if d is not None:
+            if fov_deg is not None:
+                lo, hi = (float(v) for v in lo_hi)
+                d["sensor"] = {"fov_deg": lo if lo == hi else float(rng.uniform(lo, hi))}
             return d
     raise RuntimeError("random_scene: could not place the scene; relax the parameters")
 

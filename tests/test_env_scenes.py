@@ -85,3 +85,36 @@ def test_some_pose_recognizes_with_scene_fov(name):
         if found:
             break
     assert found
+
+
+def test_random_scenes_with_drawn_fields_of_view():
+    """``random_scene(fov_deg=(lo, hi))`` adds a drawn ``sensor.fov_deg`` and leaves the
+    geometry as it was; a pool made with it gives each sub-env its scene's field of view."""
+    import math
+
+    import numpy as np
+
+    from geometry.generate import random_scene
+
+    plain = random_scene(np.random.default_rng(7))
+    drawn = random_scene(np.random.default_rng(7), fov_deg=(90, 360))
+    assert "sensor" not in plain
+    assert {k: v for k, v in drawn.items() if k != "sensor"} == plain
+    assert 90 <= drawn["sensor"]["fov_deg"] <= 360
+    assert random_scene(np.random.default_rng(7), fov_deg=150)["sensor"] == {"fov_deg": 150.0}
+    with pytest.raises(ValueError, match="fov_deg"):
+        random_scene(np.random.default_rng(7), fov_deg=(200, 100))
+    venv = gym.make_vec(
+        "sensorplan/Navigate-v0",
+        num_envs=8,
+        vectorization_mode="vector_entry_point",
+        scene="random",
+        random_scene_kwargs={"fov_deg": [90, 360]},
+        scene_pool_size=8,
+    )
+    venv.reset(seed=0)
+    fov = np.degrees(venv.unwrapped.batch.fov)
+    assert np.all((fov >= 90 - 1e-9) & (fov <= 360 + 1e-9)) and np.ptp(fov) > 30
+    for i, w in enumerate(venv.unwrapped.batch.worlds):
+        assert math.isclose(w.fov, math.radians(fov[i]))
+        assert math.isclose(w.fov, math.radians(w.scene.sensor.fov_deg))
