@@ -33,6 +33,7 @@ from pathlib import Path
 from typing import Any
 
 from .evaluate import evaluate
+from .policies import make_env
 
 __all__ = ["DEFAULT_DIFFICULTY", "TEST_POOL_SEED", "TRAIN_POOL_SEED", "benchmark", "splits"]
 
@@ -98,14 +99,13 @@ def benchmark(
     """Evaluate ``policies`` on every split (``deterministic=False``: trained models sample
     their actions); returns ``{"splits": {name: results}, "rows":
     [...]}`` (one row per split and policy) and writes benchmark.json / .csv to ``out``."""
-    import gymnasium as gym
 
     import sensorplan_gym  # noqa: F401
 
     from .evaluate import EVAL_SEED_BASE
 
     base = dict(env_kwargs or {})
-    probe = gym.make(env_id, **{k: v for k, v in base.items() if k != "scene"})
+    probe = make_env(env_id, {k: v for k, v in base.items() if k != "scene"})
     needs_start = bool(probe.unwrapped.batch.needs_start)
     probe.close()
     sp = splits(split_names or ["train", "test", "ood"], difficulty, needs_start)

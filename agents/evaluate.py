@@ -42,7 +42,7 @@ from typing import Any
 
 import numpy as np
 
-from .policies import load_policy, model_config, policy_label
+from .policies import load_policy, make_env, model_config, policy_label
 from .stats import iqm, normalized_score, stratified_bootstrap_ci, wilson_interval
 
 __all__ = ["EVAL_SEED_BASE", "evaluate", "format_table", "run_episodes"]
@@ -270,7 +270,7 @@ def evaluate(
         "files": {},
     }
     for name, spec in zip(names, policies, strict=True):
-        env = gym.make(env_id, **env_kwargs)
+        env = make_env(env_id, env_kwargs)
         try:
             policy = load_policy(spec, env, seed=seed)
             meta: dict[str, Any] = {"kind": spec if spec in ("oracle", "random") else "model"}

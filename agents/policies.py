@@ -34,6 +34,7 @@ __all__ = [
     "ModelPolicy",
     "RandomPolicy",
     "load_policy",
+    "make_env",
     "model_config",
     "policy_label",
     "vecnormalize_path",
@@ -65,6 +66,24 @@ def algo_class(name: str):
 
     classes = {"ppo": sb3.PPO, "sac": sb3.SAC, "td3": sb3.TD3, "a2c": sb3.A2C, "dqn": sb3.DQN}
     return classes[key]
+
+
+def make_env(env_id: str, env_kwargs: dict | None = None, **extra: Any):
+    """``gym.make(env_id, **env_kwargs, **extra)``, with a keyword the env does not take
+    reported as a ``ValueError`` that names it (Gymnasium raises a ``TypeError`` from deep
+    inside the env creator)."""
+    import gymnasium as gym
+
+    kw = {**(env_kwargs or {}), **extra}
+    try:
+        return gym.make(env_id, **kw)
+    except TypeError as e:
+        if "unexpected keyword" not in str(e):
+            raise
+        raise ValueError(
+            f"env kwargs {sorted(kw)} for {env_id}: {e.args[0].split(' was raised')[0]} "
+            "(see the env's docstring for the keywords it takes)"
+        ) from None
 
 
 def vecnormalize_path(model_path: str | Path) -> Path:

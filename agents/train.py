@@ -50,7 +50,7 @@ from typing import Any
 import numpy as np
 import yaml
 
-from .policies import ALGOS, algo_class
+from .policies import ALGOS, algo_class, make_env
 
 __all__ = [
     "CONFIG_DIR",
@@ -194,7 +194,7 @@ def check_algo_env(algo: str, env_id: str, env_kwargs: dict) -> None:
 
     import sensorplan_gym  # noqa: F401
 
-    env = gym.make(env_id, **env_kwargs)
+    env = make_env(env_id, env_kwargs)
     try:
         space = env.action_space
     finally:
@@ -387,9 +387,12 @@ def train(
             eval_env = VecMonitor(eval_env)
         venv = VecNormalize(venv, **norm_kw)
         # the evaluation env uses the training statistics (EvalCallback syncs them), frozen
-        eval_env = VecNormalize(eval_env, training=False, norm_reward=False, **{
-            k: v for k, v in norm_kw.items() if k not in ("norm_reward",)
-        })
+        eval_env = VecNormalize(
+            eval_env,
+            training=False,
+            norm_reward=False,
+            **{k: v for k, v in norm_kw.items() if k not in ("norm_reward",)},
+        )
     if frame_stack > 1:
         from stable_baselines3.common.vec_env import VecFrameStack
 

@@ -173,7 +173,8 @@ def random_scene(
         lo_hi = (fov_deg, fov_deg) if np.isscalar(fov_deg) else tuple(fov_deg)
         if len(lo_hi) != 2 or not all(0 < float(v) <= 360 for v in lo_hi) or lo_hi[0] > lo_hi[1]:
             raise ValueError(
-                f"fov_deg must be a number in (0, 360] or a (low, high) pair of them, got {fov_deg!r}"
+                "fov_deg must be a number in (0, 360] or a (low, high) pair of them, "
+                f"got {fov_deg!r}"
             )
     failure = failure or goal
     for _ in range(max_tries):

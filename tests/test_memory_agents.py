@@ -141,9 +141,7 @@ def test_stochastic_evaluation_is_seeded_and_recorded(stacked_run, tmp_path):
 
 
 def test_fixed_start_episodes_are_marked_dependent(tmp_path):
-    r = evaluate(
-        NAV, ["random"], episodes=2, env_kwargs={"scene": "lab"}, out=False, verbose=False
-    )
+    r = evaluate(NAV, ["random"], episodes=2, env_kwargs={"scene": "lab"}, out=False, verbose=False)
     assert r["independent_episodes"] is False
     r = evaluate(
         NAV,

@@ -274,3 +274,15 @@ def test_evaluate_function_iqm_over_training_seeds(tiny_run, tmp_path):
     a = res["iqm"]["ppo"]
     assert a["n_runs"] == 2 and a["ci95"][0] <= a["iqm"] <= a["ci95"][1]
     assert res["files"] == {}
+
+
+@pytest.mark.parametrize("command", ["evaluate", "train", "benchmark"])
+def test_cli_names_an_env_kwarg_the_env_does_not_take(command, capsys):
+    args = {
+        "evaluate": ["evaluate", "--env", NAV, "--policies", "random", "--episodes", "1"],
+        "train": ["train", "--env", NAV, "--algo", "ppo", "--timesteps", "8"],
+        "benchmark": ["benchmark", "--env", NAV, "--policies", "random", "--episodes", "1"],
+    }[command]
+    assert main([*args, "--env-kwargs", '{"fov": 3}']) == 2
+    err = capsys.readouterr().err
+    assert "'fov'" in err and "Traceback" not in err
