@@ -1,0 +1,379 @@
+"""The reference results of the learned baselines: train, benchmark and tabulate the grid.
+
+``python -m benchmarks.reference train [--only NAME ...] [--seeds 0 1 2 3 4]``
+    trains every entry of :data:`GRID` (algorithm x env, on the procedural ``train`` pool)
+    for each seed, into ``runs/<name>_<env>_random_s<seed>``; a run whose
+    ``final_model.zip`` exists is skipped.  Each run is exactly the ``sensorplan train``
+    command that ``--print`` shows.  Hours of CPU for the whole grid; one entry and seed
+    takes minutes (README lists them).
+``python -m benchmarks.reference evaluate [--episodes 100]``
+    runs ``sensorplan benchmark`` (:func:`agents.benchmark.benchmark`) per env on the splits
+    ``train``, ``test`` (held-out procedural scenes) and ``ood`` (every bundled scene, never
+    trained on), with the oracle, the random policy and every trained model found; results
+    in ``runs/reference/<env>[-discrete]/``.
+``python -m benchmarks.reference report [--update-results]``
+    the markdown table per env: success per split, the interquartile mean over training
+    seeds with its stratified-bootstrap 95 % interval (:mod:`agents.stats`), the normalized
+    score ``(agent - random) / (oracle - random)`` on the test split and, for Navigate, the
+    mean path length over the oracle's.  Written to ``runs/reference/reference.md``; the
+    tracked ``benchmarks/results/reference.md`` only with ``--update-results``.
+
+Discrete-action agents (DQN) play the envs with ``action_type="discrete"``, where the
+analytic oracle does not run: their normalized score uses the oracle's success from the
+continuous env (1.00 on every split) and the random policy of the discrete action set.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import shlex
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+NAV = "sensorplan/Navigate-v0"
+REC = "sensorplan/Recognize-v0"
+PLACE = "sensorplan/Placement-v0"
+RUNS = Path("runs")
+OUT = RUNS / "reference"
+TRACKED = Path(__file__).parent / "results" / "reference.md"
+SEEDS = (0, 1, 2, 3, 4)
+
+#: training env kwargs per env: the procedural train pool at the benchmark's difficulty
+NAV_TRAIN = {"scene": "random", "min_start_distance": 0.35, "max_scene_tries": 200}
+REC_TRAIN = {"scene": "random", "min_start_distance": 0.2, "max_scene_tries": 200}
+PLACE_TRAIN = {"scene": "random"}
+#: evaluation env kwargs per env (what the agents observe; no reward shaping)
+REC_EVAL = {"map_ranges": True, "map_evidence": True, "declare_hold": 3, "random_start": True}
+EVAL_KWARGS = {NAV: {}, REC: REC_EVAL, PLACE: {}}
+
+_PPO_NAV_HP = {
+    "n_envs": 64,
+    "n_steps": 32,
+    "policy_kwargs": {"net_arch": [128, 128], "activation_fn": "tanh"},
+    "eval_freq": 100_000,
+    "n_eval_episodes": 100,
+}
+_PPO_PLACE_HP = {
+    "n_envs": 64,
+    "n_steps": 16,
+    "batch_size": 256,
+    "n_epochs": 10,
+    "policy_kwargs": {"net_arch": [256, 256], "activation_fn": "tanh"},
+    "eval_freq": 100_000,
+    "n_eval_episodes": 200,
+}
+
+
+@dataclass(frozen=True)
+class Entry:
+    """One cell family of the grid: an agent trained on one env's procedural scenes."""
+
+    name: str  # run-folder prefix, e.g. "ppo" -> runs/ppo_navigate_random_s0
+    label: str  # the table's row label
+    env_id: str
+    algo: str
+    timesteps: int
+    env_kwargs: dict[str, Any]
+    hp: dict[str, Any] = field(default_factory=dict)
+    config: str | None = None
+    discrete: bool = False
+
+    def out(self, seed: int) -> Path:
+        env = self.env_id.split("/")[-1].split("-v")[0].lower()
+        return RUNS / f"{self.name}_{env}_random_s{seed}"
+
+    def command(self, seed: int) -> str:
+        """The ``sensorplan train`` command of this entry and seed."""
+        parts = [
+            "sensorplan train --env",
+            self.env_id,
+            "--algo",
+            self.algo,
+            "--timesteps",
+            str(self.timesteps),
+            "--seed",
+            str(seed),
+        ]
+        if self.config:
+            parts += ["--config", self.config]
+        parts += ["--env-kwargs", shlex.quote(json.dumps(self.env_kwargs))]
+        if self.hp:
+            parts += ["--hp", *(shlex.quote(f"{k}={json.dumps(v)}") for k, v in self.hp.items())]
+        parts += ["--out", str(self.out(seed))]
+        return " ".join(parts)
+
+
+GRID: list[Entry] = [
+    Entry("ppo", "PPO", NAV, "ppo", 800_000, {**NAV_TRAIN, "random_start": False}, _PPO_NAV_HP),
+    Entry("ppo", "PPO", REC, "ppo", 800_000, REC_TRAIN),
+    Entry("ppo", "PPO", PLACE, "ppo", 300_000, {**PLACE_TRAIN, "shaping": 1.0}, _PPO_PLACE_HP),
+    Entry(
+        "ppofs4",
+        "PPO + 4 stacked frames (memory)",
+        REC,
+        "ppo",
+        800_000,
+        REC_TRAIN,
+        config="agents/configs/ppo_framestack.yaml",
+    ),
+    Entry(
+        "dqn",
+        "DQN (discrete actions)",
+        PLACE,
+        "dqn",
+        200_000,
+        {**PLACE_TRAIN, "action_type": "discrete"},
+        {"eval_freq": 50_000, "n_eval_episodes": 200},
+        discrete=True,
+    ),
+    Entry(
+        "dqn",
+        "DQN (discrete actions)",
+        REC,
+        "dqn",
+        400_000,
+        {**REC_TRAIN, "action_type": "discrete", "map_evidence": True, "random_start": True},
+        {"eval_freq": 100_000, "n_eval_episodes": 100},
+        discrete=True,
+    ),
+    Entry(
+        "dqn",
+        "DQN (discrete actions)",
+        NAV,
+        "dqn",
+        400_000,
+        {**NAV_TRAIN, "action_type": "discrete"},
+        {"eval_freq": 100_000, "n_eval_episodes": 100},
+        discrete=True,
+    ),
+    Entry(
+        "sac",
+        "SAC",
+        PLACE,
+        "sac",
+        50_000,
+        {**PLACE_TRAIN, "shaping": 1.0},
+        {
+            "n_envs": 8,
+            "vec_env": "batched",
+            "eval_freq": 10_000,
+            "n_eval_episodes": 200,
+            "policy_kwargs": {"net_arch": [256, 256]},
+        },
+    ),
+    Entry("sac", "SAC", REC, "sac", 200_000, REC_TRAIN),
+    Entry(
+        "sac",
+        "SAC",
+        NAV,
+        "sac",
+        200_000,
+        NAV_TRAIN,
+        {
+            "n_envs": 8,
+            "vec_env": "batched",
+            "eval_freq": 50_000,
+            "n_eval_episodes": 100,
+            "policy_kwargs": {"net_arch": [128, 128]},
+        },
+    ),
+]
+
+
+def _selected(only: list[str] | None) -> list[Entry]:
+    if not only:
+        return GRID
+    keys = {f"{e.name}:{e.env_id.split('/')[-1]}" for e in GRID} | {e.name for e in GRID}
+    bad = [o for o in only if o not in keys]
+    if bad:
+        raise SystemExit(f"unknown entries {bad}; choose from {sorted(keys)}")
+    return [e for e in GRID if e.name in only or f"{e.name}:{e.env_id.split('/')[-1]}" in only]
+
+
+def train_grid(entries: list[Entry], seeds: list[int]) -> None:
+    """Train every entry x seed whose final model is missing (the commands of ``--print``)."""
+    from agents.cli import _hp_overrides
+    from agents.train import train
+
+    for e in entries:
+        for s in seeds:
+            if (e.out(s) / "final_model.zip").is_file():
+                print(f"skip {e.out(s)} (trained)", flush=True)
+                continue
+            print(e.command(s), flush=True)
+            hp = _hp_overrides([f"{k}={json.dumps(v)}" for k, v in e.hp.items()]) if e.hp else {}
+            train(
+                e.env_id,
+                e.algo,
+                timesteps=e.timesteps,
+                seed=s,
+                env_kwargs=e.env_kwargs,
+                config=e.config,
+                out=e.out(s),
+                hp_overrides=hp,
+                tensorboard=False,
+                progress_bar=False,
+            )
+
+
+def _models(entries: list[Entry]) -> list[str]:
+    return [
+        str(e.out(s) / "best_model.zip")
+        for e in entries
+        for s in range(100)
+        if (e.out(s) / "best_model.zip").is_file()
+    ]
+
+
+def _group_dir(env_id: str, discrete: bool) -> Path:
+    return OUT / (env_id.split("/")[-1] + ("-discrete" if discrete else ""))
+
+
+def evaluate_grid(episodes: int, seed: int = 0) -> None:
+    """``sensorplan benchmark`` per env (and per action type) with every trained model."""
+    from agents.benchmark import benchmark
+
+    for env_id in (PLACE, REC, NAV):
+        for discrete in (False, True):
+            entries = [e for e in GRID if e.env_id == env_id and e.discrete == discrete]
+            models = _models(entries)
+            if not models:
+                continue
+            base = ["random"] if discrete else ["oracle", "random"]
+            kw = dict(EVAL_KWARGS[env_id], **({"action_type": "discrete"} if discrete else {}))
+            benchmark(
+                env_id,
+                base + models,
+                episodes=episodes,
+                seed=seed,
+                env_kwargs=kw,
+                out=_group_dir(env_id, discrete),
+            )
+
+
+def _cell(rates: list[float], seed: int = 0) -> str:
+    from agents.stats import iqm, stratified_bootstrap_ci
+
+    if not rates:
+        return "—"
+    if len(rates) == 1:
+        return f"{rates[0]:.2f} (1 seed)"
+    est, lo, hi = stratified_bootstrap_ci(np.array([[r] for r in rates]), iqm, seed=seed)
+    return f"{est:.2f} [{lo:.2f}, {hi:.2f}]"
+
+
+def report() -> str:
+    """The markdown tables of the evaluated grid."""
+    out = []
+    for env_id in (PLACE, REC, NAV):
+        rows: dict[str, dict] = {}
+        splits: list[str] = []
+        base: dict[tuple[str, str], float] = {}
+        path: dict[tuple[str, str], float] = {}
+        for discrete in (False, True):
+            f = _group_dir(env_id, discrete) / "benchmark.json"
+            if not f.is_file():
+                continue
+            res = json.loads(f.read_text())
+            for sp, r in res["splits"].items():
+                if sp not in splits:
+                    splits.append(sp)
+                for p in r["policies"]:
+                    if p["kind"] in ("oracle", "random"):
+                        key = p["kind"] + (" (discrete)" if discrete else "")
+                        base[(key, sp)] = p["success_rate"]
+                        path[(key, sp)] = p["mean_path_length"]
+                        rows.setdefault(key, {"n": 1})
+                        continue
+                    entry = next(
+                        (
+                            e
+                            for e in GRID
+                            if e.env_id == env_id
+                            and Path(p["spec"]).parent.name.startswith(e.out(0).name[:-1])
+                        ),
+                        None,
+                    )
+                    label = entry.label if entry else Path(p["spec"]).parent.name
+                    row = rows.setdefault(label, {"n": 0, "discrete": discrete, "runs": set()})
+                    row["runs"].add(p["spec"])
+                    row.setdefault(sp, []).append(p["success_rate"])
+                    row.setdefault(f"path:{sp}", []).append(p["mean_path_length"])
+        if not rows:
+            continue
+        short = env_id.split("/")[-1]
+        head = ["agent", "seeds", *splits, "normalized (test)"]
+        if env_id == NAV:
+            head.append("path / oracle (test)")
+        lines = [f"**{short}**", "", "| " + " | ".join(head) + " |"]
+        lines.append("| " + " | ".join(["---"] * len(head)) + " |")
+        for label, row in rows.items():
+            if label in ("oracle", "random", "random (discrete)"):
+                cells = [
+                    label,
+                    "—",
+                    *(f"{base.get((label, sp), float('nan')):.2f}" for sp in splits),
+                ]
+                cells.append("1.00" if label == "oracle" else "0.00")
+                if env_id == NAV:
+                    o = path.get(("oracle", "test"))
+                    p_ = path.get((label, "test"))
+                    cells.append(f"{p_ / o:.2f}" if o and p_ is not None else "—")
+                lines.append("| " + " | ".join(cells) + " |")
+                continue
+            rnd = "random (discrete)" if row["discrete"] else "random"
+            n = len(row["runs"])
+            cells = [label, str(n), *(_cell(row.get(sp, [])) for sp in splits)]
+            o, r0 = base.get(("oracle", "test"), 1.0), base.get((rnd, "test"))
+            if r0 is not None and o > r0 and row.get("test"):
+                cells.append(_cell([(x - r0) / (o - r0) for x in row["test"]]))
+            else:
+                cells.append("—")
+            if env_id == NAV:
+                op = path.get(("oracle", "test"))
+                ps = row.get("path:test", [])
+                cells.append(f"{np.median(ps) / op:.2f} (median of seeds)" if op and ps else "—")
+            lines.append("| " + " | ".join(cells) + " |")
+        out.append("\n".join(lines))
+    return "\n\n".join(out) + "\n"
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m benchmarks.reference", description=__doc__)
+    sub = ap.add_subparsers(dest="cmd", required=True)
+    t = sub.add_parser("train", help="train the grid (skips finished runs)")
+    t.add_argument("--only", nargs="+", default=None, help="entries: NAME or NAME:Env-v0")
+    t.add_argument("--seeds", nargs="+", type=int, default=list(SEEDS))
+    t.add_argument("--print", action="store_true", help="print the commands, train nothing")
+    ev = sub.add_parser("evaluate", help="benchmark every trained model on every split")
+    ev.add_argument("--episodes", type=int, default=100)
+    rp = sub.add_parser("report", help="the markdown tables")
+    rp.add_argument("--update-results", action="store_true")
+    args = ap.parse_args(argv)
+    if args.cmd == "train":
+        entries = _selected(args.only)
+        if args.print:
+            for e in entries:
+                for s in args.seeds:
+                    print(e.command(s))
+            return 0
+        train_grid(entries, args.seeds)
+    elif args.cmd == "evaluate":
+        evaluate_grid(args.episodes)
+    else:
+        text = report()
+        OUT.mkdir(parents=True, exist_ok=True)
+        (OUT / "reference.md").write_text(text)
+        if args.update_results:
+            TRACKED.write_text(text)
+        print(text)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

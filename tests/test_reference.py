@@ -1,0 +1,57 @@
+"""The reference-results grid (benchmarks.reference): its commands are valid ``sensorplan
+train`` commands that name their own run folders, and the report computes the IQM,
+intervals and normalized scores from benchmark results."""
+
+from __future__ import annotations
+
+import json
+import shlex
+
+import pytest
+
+pytest.importorskip("yaml")
+
+from agents.cli import _hp_overrides, build_parser  # noqa: E402
+from benchmarks import reference  # noqa: E402
+
+
+def test_grid_commands_parse_and_match_their_entries():
+    parser = build_parser()
+    seen = set()
+    for e in reference.GRID:
+        args = parser.parse_args(shlex.split(e.command(3))[1:])
+        assert args.env == e.env_id and args.algo == e.algo and args.seed == 3
+        assert args.timesteps == e.timesteps and args.out == str(e.out(3))
+        assert args.env_kwargs == e.env_kwargs
+        if e.hp:
+            assert _hp_overrides(args.hp) == e.hp
+        assert (e.name, e.env_id) not in seen
+        seen.add((e.name, e.env_id))
+        assert e.discrete == (e.env_kwargs.get("action_type") == "discrete")
+
+
+def test_report_tabulates_iqm_and_normalized_score(tmp_path, monkeypatch):
+    monkeypatch.setattr(reference, "OUT", tmp_path)
+    monkeypatch.setattr(reference, "RUNS", tmp_path / "runs")
+    entry = next(e for e in reference.GRID if e.name == "ppo" and e.env_id == reference.PLACE)
+    rates = [0.8, 0.9, 1.0, 0.7]
+
+    def pol(kind, spec, sr):
+        return {"kind": kind, "spec": spec, "success_rate": sr, "mean_path_length": 0.0}
+
+    split = {
+        "policies": [pol("oracle", "oracle", 1.0), pol("random", "random", 0.2)]
+        + [pol("model", str(entry.out(s) / "best_model.zip"), r) for s, r in enumerate(rates)]
+    }
+    d = tmp_path / "Placement-v0"
+    d.mkdir()
+    (d / "benchmark.json").write_text(json.dumps({"splits": {"test": split}}))
+    text = reference.report()
+    row = next(line for line in text.splitlines() if line.startswith("| PPO |"))
+    cells = [c.strip() for c in row.strip("|").split("|")]
+    assert cells[1] == "4"
+    # IQM of 4 runs = mean of the middle two (0.8, 0.9)
+    assert cells[2].startswith("0.85 [")
+    # normalized (x - 0.2) / 0.8 -> IQM of the middle two = (0.75 + 0.875) / 2
+    assert cells[3].startswith("0.81 [")
+    assert "| oracle | — | 1.00 | 1.00 |" in text
