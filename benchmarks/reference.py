@@ -122,6 +122,15 @@ GRID: list[Entry] = [
         config="agents/configs/ppo_framestack.yaml",
     ),
     Entry(
+        "ppofs4",
+        "PPO + 4 stacked frames (memory)",
+        NAV,
+        "ppo",
+        800_000,
+        {**NAV_TRAIN, "random_start": False},
+        config="agents/configs/ppo_framestack.yaml",
+    ),
+    Entry(
         "dqn",
         "DQN (discrete actions)",
         PLACE,
