@@ -99,9 +99,11 @@ def partial_region(
         the edges of the region's boundary left to sweep.  ``None``: no limit.
     progress : only with ``target_in``: ``progress(done, total)`` is called after
         every swept edge of the region's boundary.
-    conservative : only with ``target_in``: grow the shadows by ``tol``, so that
-        the answer lies inside the exact region as long as the sweep misses no
-        shadow deeper than ``tol`` (none deeper than 0.003 ``tol`` was measured;
+    conservative : only with ``target_in``: grow the shadows by ``tol`` (plus the
+        ~1e-12 D snap-rounding grid of their union, see
+        :func:`~geometry.sweep.swept_shadows`), so that the answer lies inside
+        the exact region as long as the sweep misses no shadow deeper than ``tol``
+        (none deeper than 0.003 ``tol`` was measured;
         see docs/DESIGN.md, "What is and is not guaranteed").
 
     Returns
@@ -190,7 +192,7 @@ def _swept_region(
     spec = target_spec(scene, None, target_in, float(theta))
     region = scene.region(target_in) if isinstance(target_in, str) else target_in
     target = _ccw_ring(scene.target_at(0.0, 0.0, float(theta)))
-    shadows, _ = swept_shadows(
+    shadows, stats = swept_shadows(
         scene_domain(scene),
         scene.free_space,
         target,
@@ -203,7 +205,8 @@ def _swept_region(
         what=budget.what,
     )
     if conservative:
-        shadows = disc_sum(shadows, tol)
+        # tol: the traced arcs' chords; grid: the snap-rounding of the union (sweep.py)
+        shadows = disc_sum(shadows, tol + stats["grid"])
     allowed = shapely.difference(scene.free_space, spec.area)
     out = polygonal(shapely.difference(allowed, shadows))
     if eps_pos > 0:

@@ -45,6 +45,7 @@ between).  What this does not prove is listed in docs/DESIGN.md.
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -60,6 +61,10 @@ from ._vis import TAU, Domain, RayEscapeError, gaps_many
 from .weak import ENV as _ENV
 from .weak import WANTED as _WANTED
 from .weak import weak_visibility
+
+#: The union of the pieces is snap-rounded onto a grid of ``2**-GRID_BITS`` of the scene's
+#: size (about 1e-12): see :func:`swept_shadows`.
+GRID_BITS = 40
 
 __all__ = ["QueryTimeout", "Sweeper", "star_center", "swept_shadows"]
 
@@ -140,6 +145,8 @@ class Sweeper:
         shapely.prepare(self._hull_poly)
         self.h = 1e-7 * self.env.scale
         self.tol_lab = 1e-8 * self.env.scale
+        #: snap-rounding grid of the final union (scene units, a power of two)
+        self.grid = snap_grid(self.env.scale)
 
     # ------------------------------------------------------------------ anchors
     def pos(self, ids: np.ndarray, q: np.ndarray) -> np.ndarray:
@@ -798,7 +805,21 @@ def swept_shadows(
     The target must be star-shaped; the sweep runs over the boundary of the
     region with the reference point moved into the target's kernel (the swept
     set of placements does not depend on that choice).  Returns the union (a
-    shapely geometry, world frame) and counters.
+    shapely geometry, world frame) and counters (``stats["grid"]``: the snap-rounding
+    grid, below).
+
+    The pieces (sampled shadows and traced quads, a few hundred for a long edge of G)
+    are united by GEOS *snap-rounding* on a grid of ``2**-GRID_BITS`` of the scene's size
+    (``stats["grid"]``), not by its floating-point overlay.  The floating overlay
+    (OverlayNG with its heuristic fallbacks) is not robust on such inputs: nearly
+    coincident shadows whose boolean construction left collapsed parts (rings of two
+    distinct points a few ulps apart, which GEOS's validity check accepts) and zero-width
+    spikes made it return, without an error, a union that lacked up to half of one of
+    its inputs (fuzz seeds 410993, 411063, 421105: the swept region then held placements
+    that the stationary shadow at a vertex of G blinds).  Snap-rounding is GEOS's fully
+    robust overlay: its output is valid and every point of it lies within
+    ``grid / sqrt(2)`` of the exact union and vice versa; ``conservative=True`` grows the
+    union by ``tol + grid`` to cover that too.
     """
     c = star_center(target)
     if c is None:
@@ -841,7 +862,14 @@ def swept_shadows(
                 stats[k] += st[k]
             if progress is not None:
                 progress(done + 1, len(segs))
-    return polygonal(shapely.union_all(pieces)), stats
+    stats["grid"] = sw.grid
+    return polygonal(shapely.union_all(pieces, grid_size=sw.grid)), stats
+
+
+def snap_grid(scale: float) -> float:
+    """The snap-rounding grid of the swept union for a scene of size ``scale`` (scene
+    units): the power of two nearest below ``2**-GRID_BITS * scale``."""
+    return math.ldexp(1.0, math.floor(math.log2(scale)) - GRID_BITS)
 
 
 def _region_pts(region: shapely.Geometry) -> np.ndarray:

@@ -31,6 +31,12 @@ from geometry.fuzz import check_scene, fuzz_scene, run_many
 #: grid before mapping); 106185 -- GEOS buffer disc sums cutting into the disc.
 REGRESSION_SEEDS = [27, 37, 223, 440, 481, 496, 100833, 102667, 106185, 302211, 309618, 2424114]
 
+#: Swept-query seeds: 410993, 411063, 421105 -- the union of the sweep's pieces (sampled
+#: shadows with collapsed parts a few ulps wide, and traced quads) by GEOS's floating-point
+#: overlay silently lost up to half a shadow, so the swept partial region held placements
+#: blinded at a vertex of G ("translating ⊆ stationary (partial)"); now snap-rounded.
+SWEPT_REGRESSION_SEEDS = [410993, 411063, 421105]
+
 
 def _assert_clean(seed: int, swept: bool = False) -> None:
     d = fuzz_scene(seed)
@@ -45,6 +51,11 @@ def _assert_clean(seed: int, swept: bool = False) -> None:
 @pytest.mark.parametrize("seed", REGRESSION_SEEDS)
 def test_regression_seeds(seed):
     _assert_clean(seed)
+
+
+@pytest.mark.parametrize("seed", SWEPT_REGRESSION_SEEDS)
+def test_swept_regression_seeds(seed):
+    _assert_clean(seed, swept=True)
 
 
 @settings(max_examples=60, deadline=None)
