@@ -87,6 +87,42 @@ def test_translating_region_is_inside_stationary_regions():
         assert moving.difference(fixed).area < 1e-9
 
 
+#: Fuzz scene 421105 (issue 10): an L-shaped room, one obstacle, a regular octagon
+#: translating through a hexagon G at theta = 2.7223 rad.
+FUZZ_421105 = {
+    "name": "fuzz421105",
+    "bounds": [[0.0, 0.0], [17560.178344726562, 0.0], [17560.178344726562, 7217.297073364258],
+               [10932.060562133789, 7217.297073364258], [10932.060562133789, 19358.651344299316],
+               [0.0, 19358.651344299316]],
+    "obstacles": [
+        [[4015.384651184082, 13206.549446105957], [626.6466979980469, 13342.866134643555],
+         [666.4097900390625, 16756.04573059082], [3826.900100708008, 17448.713218688965]]
+    ],
+    "target": [[434.9283905029297, 65.37564849853516], [261.31324768066406, 353.7683792114258],
+               [-65.37564849853516, 434.9283905029297], [-353.7683792114258, 261.31324768066406],
+               [-434.9283905029297, -65.37564849853516], [-261.31324768066406, -353.7683792114258],
+               [65.37564849853516, -434.9283905029297], [353.7683792114258, -261.31324768066406]],
+    "goal": [[7926.815170288086, 8831.596633911133], [7801.542037963867, 9093.327354431152],
+             [7428.7209396362305, 9104.028228759766], [7393.978088378906, 8863.581146240234],
+             [7585.668212890625, 8525.86001586914], [7866.631088256836, 8547.19524383545]],
+    "failure": [[8475.995529174805, 2983.683937072754]],
+}  # fmt: skip
+
+
+def test_swept_partial_region_lies_in_the_stationary_ones_at_the_vertices_of_g():
+    """The swept shadows contain the stationary shadow at every vertex of G, so the swept
+    partial region lies inside each stationary one.  Here GEOS's floating-point union of
+    the sweep's 12 pieces (nearly coincident shadows, some with collapsed parts a few ulps
+    wide) silently lost half a shadow: the region was 0.0144 D^2 too large (issue 10)."""
+    sc = Scene.from_dict(FUZZ_421105)
+    theta = 2.722259774894832
+    swept = partial_region(sc, target_in="goal", theta=theta, conservative=True)
+    assert swept.area > 0
+    for x, y in sc.goal:
+        fixed = partial_region(sc, target_at=(x, y, theta))
+        assert swept.difference(fixed).area <= 1e-8 * sc.diameter**2
+
+
 def test_rotating_target_uses_disc_tangents():
     # G is the point (0,0); with any orientation the target sweeps the disc of
     # radius sqrt(2).  The tangents from the block corner (1,3) to that disc.
