@@ -76,16 +76,27 @@ def random_polygon(
     return pts
 
 
-def _room(rng: np.random.Generator, width: float, height: float, notches: int) -> Polygon:
-    """A ``width x height`` rectangle with ``notches`` rectangular corner cut-outs."""
+def _room(
+    rng: np.random.Generator,
+    width: float,
+    height: float,
+    notches: int,
+    notch_size: tuple[float, float] = (0.12, 0.3),
+) -> Polygon | None:
+    """A ``width x height`` rectangle with ``notches`` rectangular corner cut-outs, each
+    ``notch_size`` (a range of fractions of the width and of the height) large; ``None``
+    when the cut-outs split the room."""
     room = shapely.box(0.0, 0.0, width, height)
     corners = rng.permutation(4)[:notches]
+    lo, hi = notch_size
     for k in corners:
-        w = width * rng.uniform(0.12, 0.3)
-        h = height * rng.uniform(0.12, 0.3)
+        w = width * rng.uniform(lo, hi)
+        h = height * rng.uniform(lo, hi)
         x0 = 0.0 if k in (0, 3) else width - w
         y0 = 0.0 if k in (0, 1) else height - h
         room = room.difference(shapely.box(x0, y0, x0 + w, y0 + h))
+    if not isinstance(room, Polygon) or room.interiors:
+        return None
     room = shapely.orient_polygons(room, exterior_cw=False)
     pts = np.asarray(_round(np.asarray(room.exterior.coords)[:-1]))
     keep = []
@@ -136,6 +147,7 @@ def random_scene(
     name: str = "random",
     max_tries: int = 200,
     fov_deg: float | tuple[float, float] | None = None,
+    notch_size: tuple[float, float] = (0.12, 0.3),
 ) -> dict[str, Any]:
     """A random scene dict in the pinned JSON format.
 
@@ -149,6 +161,8 @@ def random_scene(
     obstacle_sizes : explicit vertex count per obstacle (overrides the two above).
     room_size : ``(width, height)``; default grows with the number of obstacles.
     notches : corner cut-outs of the room (0 = rectangle; default 0..2 at random).
+    notch_size : range of a cut-out's width and height as fractions of the room's (default
+        ``(0.12, 0.3)``; up to 0.75 makes L-shaped rooms and corridors around a corner).
     convex_fraction : probability that an obstacle is convex.
     target_radius : scale of the target (default random in [0.3, 0.8]).
     rotation_clear : keep obstacles and walls off CH(G (+) disc(r)) and CH(H (+) disc(r))
@@ -169,6 +183,8 @@ def random_scene(
     dict with keys ``name, bounds, obstacles, target, goal, failure`` (and ``sensor`` when
     ``fov_deg`` is given).
     """
+    if not (len(notch_size) == 2 and 0 < notch_size[0] <= notch_size[1] < 1):
+        raise ValueError(f"notch_size must be a (low, high) pair in (0, 1), got {notch_size!r}")
     if fov_deg is not None:
         lo_hi = (fov_deg, fov_deg) if np.isscalar(fov_deg) else tuple(fov_deg)
         if len(lo_hi) != 2 or not all(0 < float(v) <= 360 for v in lo_hi) or lo_hi[0] > lo_hi[1]:
@@ -194,6 +210,7 @@ def random_scene(
             overlap=overlap,
             margin=margin,
             name=name,
+            notch_size=notch_size,
         )
         if d is not None:
             if fov_deg is not None:
@@ -220,6 +237,7 @@ def _try_scene(
     overlap,
     margin,
     name,
+    notch_size=(0.12, 0.3),
 ) -> dict[str, Any] | None:
     if obstacle_sizes is None:
         n_obs = int(rng.integers(2, 8)) if n_obstacles is None else int(n_obstacles)
@@ -234,7 +252,9 @@ def _try_scene(
         room_size = (math.sqrt(area * aspect), math.sqrt(area / aspect))
     width, height = room_size
     k_notch = int(rng.integers(0, 3)) if notches is None else int(notches)
-    room = _room(rng, width, height, k_notch)
+    room = _room(rng, width, height, k_notch, notch_size)
+    if room is None:
+        return None
 
     target = random_polygon(rng, m, r_t, convex=bool(rng.random() < 0.5))
     target = np.asarray(_round(target))

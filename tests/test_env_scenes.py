@@ -118,3 +118,27 @@ def test_random_scenes_with_drawn_fields_of_view():
     for i, w in enumerate(venv.unwrapped.batch.worlds):
         assert math.isclose(w.fov, math.radians(fov[i]))
         assert math.isclose(w.fov, math.radians(w.scene.sensor.fov_deg))
+
+
+def test_random_scenes_with_large_notches_make_valid_l_shaped_rooms():
+    """``notch_size`` widens the corner cut-outs (L-shaped rooms, corridors around a corner);
+    its default draws exactly the old scenes, and a room split by its cut-outs is redrawn."""
+    import numpy as np
+    from shapely.geometry import Polygon
+
+    from geometry.generate import random_scene
+
+    for k in range(5):
+        assert random_scene(np.random.default_rng(k)) == random_scene(
+            np.random.default_rng(k), notch_size=(0.12, 0.3)
+        )
+    ratios = []
+    for k in range(30):
+        d = random_scene(np.random.default_rng(k), notch_size=(0.3, 0.75), notches=2)
+        room = Polygon(d["bounds"])
+        assert room.is_valid and not room.interiors
+        x0, y0, x1, y1 = room.bounds
+        ratios.append(room.area / ((x1 - x0) * (y1 - y0)))
+    assert min(ratios) < 0.6  # some rooms are L-shaped
+    with pytest.raises(ValueError, match="notch_size"):
+        random_scene(np.random.default_rng(0), notch_size=(0.5, 1.2))
