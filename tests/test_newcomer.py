@@ -242,3 +242,16 @@ def test_env_class_docstrings_match_the_spaces(env_id, cls_path, vec_len, n_disc
         both = gym.make(env_id, n_beams=12, map_ranges=True, map_evidence=True)
         assert both.observation_space.shape == (8 + 6 * 12,)  # ranges n, then evidence 2n
         assert "| 8+3n ... 8+4n-1" in doc
+
+
+def test_demo_runs_end_to_end_with_the_shipped_policies(tmp_path, capsys):
+    """``sensorplan demo``: figures, the oracle's recognition, and both tables with the
+    shipped learned policies (Navigate-v0 on lab; Recognize-v0 trained on procedural scenes)."""
+    pytest.importorskip("stable_baselines3")
+    assert main(["demo", "--episodes", "2", "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert "5. Recognize-v0" in out and "ppo_recognize_random" in out
+    assert "ppo_navigate_lab" in out
+    for name in ("fig15_visibility.png", "fig16_placement.png"):
+        assert (tmp_path / name).is_file()
+    assert (tmp_path / "recognize_eval" / "results.json").is_file()
