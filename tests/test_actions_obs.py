@@ -198,3 +198,24 @@ def test_noise_is_bounded_and_the_region_allows_for_it():
     diffs = np.concatenate(diffs)
     assert diffs.max() <= NOISE_BOUND * sigma + 1e-12
     assert diffs.max() > 2 * sigma  # the tails are there, cut at the bound
+
+
+def test_sensor_fov_observation_is_the_scenes_field_of_view():
+    import math
+
+    import gymnasium as gym
+
+    for scene, fov in (("edr", 150.0), ("lab", None)):
+        env = gym.make("sensorplan/Navigate-v0", scene=scene, sensor_fov=True)
+        plain = gym.make("sensorplan/Navigate-v0", scene=scene)
+        obs, _ = env.reset(seed=0)
+        ref, _ = plain.reset(seed=0)
+        assert env.observation_space.shape[0] == plain.observation_space.shape[0] + 1
+        assert env.observation_space.contains(obs)
+        np.testing.assert_array_equal(obs[:-1], ref)
+        expect = math.degrees(env.unwrapped.world.fov) / 360.0
+        assert obs[-1] == np.float32(expect)
+        if fov is not None:
+            assert math.isclose(expect, fov / 360.0)
+    with pytest.raises(ValueError, match="sensor_fov"):
+        gym.make("sensorplan/Navigate-v0", sensor_fov=1)

@@ -18,6 +18,9 @@ obstacles, G, H), its own pose, and its sensor readings.  The hidden target of
     ``2 * n_beams`` more 0/1 values (G's beams, then H's): the beam read noticeably shorter
     than the map predicts and its end point lies in the hull of the target swept over G
     (resp. H) -- the robot's own readings interpreted with the map (:func:`map_evidence`).
+    With ``sensor_fov=True``, one more value last: the sensor's field of view divided by
+    360 degrees (in (0, 1]) -- the robot knows its own sensor, and on scenes whose field of
+    view varies it tells how far apart G and H may lie in one view.
 
     Placement, length ``8 + 2 * n_beams``: centres of G and H scaled to [-1, 1],
     the width and height of G and H's bounding boxes divided by the scene's span,
@@ -87,12 +90,14 @@ class RobotVectorObs:
         grid_size: int = 64,
         map_ranges: bool = False,
         map_evidence: bool = False,
+        sensor_fov: bool = False,
     ) -> None:
         self.n = n_beams
         n = n_beams
         self.map_ranges = map_ranges
         self.map_evidence = map_evidence
-        m = (n if map_ranges else 0) + (2 * n if map_evidence else 0)
+        self.sensor_fov = sensor_fov
+        m = (n if map_ranges else 0) + (2 * n if map_evidence else 0) + (1 if sensor_fov else 0)
         low = np.concatenate([-np.ones(8), np.zeros(n), -np.ones(2 * n), np.zeros(m)])
         self.space = spaces.Box(
             low.astype(np.float32), np.ones(8 + 3 * n + m, dtype=np.float32), dtype=np.float32
@@ -124,7 +129,10 @@ class RobotVectorObs:
             out[:, j : j + n] = sim.map_dist[sel] * K[:, 5:6]
             j += n
         if self.map_evidence:
-            out[:, j:] = map_evidence(sim, sel, x, y, psi).reshape(len(x), 2 * n)
+            out[:, j : j + 2 * n] = map_evidence(sim, sel, x, y, psi).reshape(len(x), 2 * n)
+            j += 2 * n
+        if self.sensor_fov:
+            out[:, j] = sim.fov[sel] / (2.0 * math.pi)
         # every entry is within its bounds up to rounding of order 1e-16, which the float32
         # conversion absorbs (values within 2**-25 of +-1 round to +-1)
         return out.astype(np.float32)
@@ -243,10 +251,11 @@ def make_observation(
     *,
     map_ranges: bool = False,
     map_evidence: bool = False,
+    sensor_fov: bool = False,
 ):
     """The observation builder for env ``kind`` ("robot" or "placement") and ``obs_type``;
-    ``map_ranges`` / ``map_evidence``: robot vector observations carry the map-predicted
-    ranges / the per-beam evidence flags too."""
+    ``map_ranges`` / ``map_evidence`` / ``sensor_fov``: robot vector observations carry the
+    map-predicted ranges / the per-beam evidence flags / the field of view too."""
     if obs_type not in OBS_TYPES:
         raise ValueError(f"obs_type must be one of {OBS_TYPES}, got {obs_type!r}")
     table = {
@@ -255,6 +264,12 @@ def make_observation(
         ("placement", "vector"): PlacementVectorObs,
         ("placement", "grid"): PlacementGridObs,
     }
-    if map_ranges or map_evidence:
-        return RobotVectorObs(n_beams, grid_size, map_ranges=map_ranges, map_evidence=map_evidence)
+    if map_ranges or map_evidence or sensor_fov:
+        return RobotVectorObs(
+            n_beams,
+            grid_size,
+            map_ranges=map_ranges,
+            map_evidence=map_evidence,
+            sensor_fov=sensor_fov,
+        )
     return table[(kind, obs_type)](n_beams, grid_size)

@@ -41,6 +41,8 @@ map_ranges : bool, default False -- Navigate/Recognize vector observations also 
 map_evidence : bool, default False -- per beam, whether it read shorter than the map predicts
     and ended in the hull of the target swept over G, resp. H (the readings interpreted with
     the map; vector observations of Navigate/Recognize).
+sensor_fov : bool, default False -- Navigate/Recognize vector observations end with the
+    sensor's field of view / 360 degrees (for scenes whose field of view varies).
 max_steps : int | None -- the time limit (default 200; Placement: 1).
 random_scene_kwargs : dict | None -- passed to ``random_scene`` when ``scene="random"``.
 render_mode : ``None`` | ``"rgb_array"`` | ``"human"``.
@@ -194,6 +196,7 @@ class SensorPlanBatch(BatchSim):
         action_type: str = "continuous",
         map_ranges: bool = False,
         map_evidence: bool = False,
+        sensor_fov: bool = False,
         **action_kw: Any,
     ) -> None:
         for name, v in (
@@ -226,7 +229,11 @@ class SensorPlanBatch(BatchSim):
         if unknown or (action_kw and self.action_task != "placement"):
             bad = sorted(action_kw if not unknown else unknown)
             raise TypeError(f"{self.task_name}: unexpected keyword argument(s) {bad}")
-        for name, v in (("map_ranges", map_ranges), ("map_evidence", map_evidence)):
+        for name, v in (
+            ("map_ranges", map_ranges),
+            ("map_evidence", map_evidence),
+            ("sensor_fov", sensor_fov),
+        ):
             if not isinstance(v, bool):
                 raise ValueError(f"{name} must be True or False, got {v!r}")
             if v and (obs_type != "vector" or self.obs_kind != "robot"):
@@ -240,6 +247,7 @@ class SensorPlanBatch(BatchSim):
             grid_size,
             map_ranges=map_ranges,
             map_evidence=map_evidence,
+            sensor_fov=sensor_fov,
         )
         self.single_observation_space = self.obs.space
         self.actions = make_actions(action_type, self.action_task, self.action_dim, **action_kw)

@@ -149,13 +149,16 @@ class NavigateEnv(SensorPlanEnv):
     |                 | predicts for each beam                    |     |     |                   |
     | next n, next n  | ``map_evidence=True``: beam evidence for  | 0   | 1   | 0/1 flags (4)     |
     |                 | G (n flags), then for H (n flags)         |     |     |                   |
+    | last            | ``sensor_fov=True``: field of view / 360  | 0   | 1   | fraction of 360   |
+    |                 | degrees (the robot's own sensor)          |     |     | degrees           |
 
     (1) ``2 (x - x_min) / (x_max - x_min) - 1`` over the scene's bounding box, clipped.
     (2) Zero where the beam hit nothing within ``reach``.  The fan: ``n_beams`` beams spread
     evenly over ``fov_deg`` centred on the heading (``2 pi / n`` apart at 360 degrees); ranges
     carry Gaussian ``noise`` (std, scene units) and are read from the *executed* sensor pose.
     (3) From the commanded pose, walls and obstacles only, no noise: what a robot carrying
-    the map expects.  Comes after the normals; ``map_evidence`` entries come last.
+    the map expects.  Comes after the normals, then the ``map_evidence`` entries, then
+    ``sensor_fov``.
     (4) 1 where the beam read shorter than the map predicts (by more than ``3 noise +
     1e-3 reach``) and its end point lies in the hull of the target swept over G (resp. H).
 
@@ -199,8 +202,8 @@ class NavigateEnv(SensorPlanEnv):
 
     Navigate's own: ``step_cost`` (0.01), ``success_bonus`` (1.0), ``shaping`` (0.0),
     ``max_speed`` (scene units per step; ``None``: 3 % of the diameter), ``max_turn`` (pi/8
-    radians per step), ``random_start`` (False).  ``map_ranges`` / ``map_evidence`` (False)
-    add the observation entries above (``obs_type="vector"`` only).
+    radians per step), ``random_start`` (False).  ``map_ranges`` / ``map_evidence`` /
+    ``sensor_fov`` (False) add the observation entries above (``obs_type="vector"`` only).
     Common to all tasks (details: ``help(sensorplan_gym.envs.base)``):
 
     * ``scene`` (``"lab"``): a bundled scene (``lab``, ``edr``, ``corridor``, ``warehouse``),
