@@ -56,6 +56,7 @@ from shapely import affinity
 
 from . import visindex as _visindex
 from ._common import polygonal
+from ._shapes import areal
 from ._shapes import cross as _cross
 from ._vis import TAU, Domain, RayEscapeError, gaps_many
 from .weak import ENV as _ENV
@@ -443,7 +444,10 @@ class Sweeper:
         while todo:
             self._check_time()
             a, b, depth = todo.pop()
-            known = shapely.union(frame(a)[0], frame(b)[0])
+            # the areal part: GEOS's union of two nearly coincident shadows can carry
+            # collapsed edges (LineStrings), and an overlay with such a collection fails
+            # ("Result area inconsistent with overlay operation", fuzz seed 501057)
+            known = areal(shapely.union(frame(a)[0], frame(b)[0]))
             for t, toward in ((a, b), (b, a)):
                 edges = self._uncovered(frame(t)[1], t, toward, known, q0, dq)
                 for e in frame(t)[1]:
