@@ -35,7 +35,9 @@ REGRESSION_SEEDS = [27, 37, 223, 440, 481, 496, 100833, 102667, 106185, 302211, 
 #: shadows with collapsed parts a few ulps wide, and traced quads) by GEOS's floating-point
 #: overlay silently lost up to half a shadow, so the swept partial region held placements
 #: blinded at a vertex of G ("translating ⊆ stationary (partial)"); now snap-rounded.
-SWEPT_REGRESSION_SEEDS = [410993, 411063, 421105]
+#: 501057 -- GEOS's union of two sampled shadows carried collapsed LineStrings and the next
+#: overlay raised "Result area inconsistent with overlay operation" (a crash).
+SWEPT_REGRESSION_SEEDS = [410993, 411063, 421105, 501057]
 
 
 def _assert_clean(seed: int, swept: bool = False) -> None:
