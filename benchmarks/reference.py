@@ -278,6 +278,8 @@ def _cell(rates: list[float], seed: int = 0) -> str:
 
 def report() -> str:
     """The markdown tables of the evaluated grid."""
+    from agents.policies import model_config
+
     out = []
     for env_id in (PLACE, REC, NAV):
         rows: dict[str, dict] = {}
@@ -310,13 +312,16 @@ def report() -> str:
                     )
                     label = entry.label if entry else Path(p["spec"]).parent.name
                     row = rows.setdefault(label, {"n": 0, "discrete": discrete, "runs": set()})
+                    if p["spec"] not in row["runs"]:
+                        cfg = model_config(p["spec"]) or {}
+                        row.setdefault("time", []).append(cfg.get("train_time_s"))
                     row["runs"].add(p["spec"])
                     row.setdefault(sp, []).append(p["success_rate"])
                     row.setdefault(f"path:{sp}", []).append(p["mean_path_length"])
         if not rows:
             continue
         short = env_id.split("/")[-1]
-        head = ["agent", "seeds", *splits, "normalized (test)"]
+        head = ["agent", "seeds", "train time / seed", *splits, "normalized (test)"]
         if env_id == NAV:
             head.append("path / oracle (test)")
         lines = [f"**{short}**", "", "| " + " | ".join(head) + " |"]
@@ -325,6 +330,7 @@ def report() -> str:
             if label in ("oracle", "random", "random (discrete)"):
                 cells = [
                     label,
+                    "—",
                     "—",
                     *(f"{base.get((label, sp), float('nan')):.2f}" for sp in splits),
                 ]
@@ -337,7 +343,9 @@ def report() -> str:
                 continue
             rnd = "random (discrete)" if row["discrete"] else "random"
             n = len(row["runs"])
-            cells = [label, str(n), *(_cell(row.get(sp, [])) for sp in splits)]
+            times = [t for t in row.get("time", []) if t is not None]
+            wall = f"{np.median(times) / 60:.1f} min" if times else "—"
+            cells = [label, str(n), wall, *(_cell(row.get(sp, [])) for sp in splits)]
             o, r0 = base.get(("oracle", "test"), 1.0), base.get((rnd, "test"))
             if r0 is not None and o > r0 and row.get("test"):
                 cells.append(_cell([(x - r0) / (o - r0) for x in row["test"]]))

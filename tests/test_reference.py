@@ -49,9 +49,9 @@ def test_report_tabulates_iqm_and_normalized_score(tmp_path, monkeypatch):
     text = reference.report()
     row = next(line for line in text.splitlines() if line.startswith("| PPO |"))
     cells = [c.strip() for c in row.strip("|").split("|")]
-    assert cells[1] == "4"
+    assert cells[1] == "4" and cells[2] == "—"  # no training record in this fake
     # IQM of 4 runs = mean of the middle two (0.8, 0.9)
-    assert cells[2].startswith("0.85 [")
+    assert cells[3].startswith("0.85 [")
     # normalized (x - 0.2) / 0.8 -> IQM of the middle two = (0.75 + 0.875) / 2
-    assert cells[3].startswith("0.81 [")
-    assert "| oracle | — | 1.00 | 1.00 |" in text
+    assert cells[4].startswith("0.81 [")
+    assert "| oracle | — | — | 1.00 | 1.00 |" in text
