@@ -243,11 +243,12 @@ def _group_dir(env_id: str, discrete: bool) -> Path:
     return OUT / (env_id.split("/")[-1] + ("-discrete" if discrete else ""))
 
 
-def evaluate_grid(episodes: int, seed: int = 0) -> None:
-    """``sensorplan benchmark`` per env (and per action type) with every trained model."""
+def evaluate_grid(episodes: int, seed: int = 0, envs: list[str] | None = None) -> None:
+    """``sensorplan benchmark`` per env (and per action type) with every trained model;
+    ``envs``: only these env ids."""
     from agents.benchmark import benchmark
 
-    for env_id in (PLACE, REC, NAV):
+    for env_id in envs or (PLACE, REC, NAV):
         for discrete in (False, True):
             entries = [e for e in GRID if e.env_id == env_id and e.discrete == discrete]
             models = _models(entries)
@@ -369,6 +370,7 @@ def main(argv: list[str] | None = None) -> int:
     t.add_argument("--print", action="store_true", help="print the commands, train nothing")
     ev = sub.add_parser("evaluate", help="benchmark every trained model on every split")
     ev.add_argument("--episodes", type=int, default=100)
+    ev.add_argument("--envs", nargs="+", default=None, help="only these env ids")
     rp = sub.add_parser("report", help="the markdown tables")
     rp.add_argument("--update-results", action="store_true")
     args = ap.parse_args(argv)
@@ -381,7 +383,7 @@ def main(argv: list[str] | None = None) -> int:
             return 0
         train_grid(entries, args.seeds)
     elif args.cmd == "evaluate":
-        evaluate_grid(args.episodes)
+        evaluate_grid(args.episodes, envs=args.envs)
     else:
         text = report()
         OUT.mkdir(parents=True, exist_ok=True)
