@@ -349,10 +349,14 @@ class Sweeper:
         hit = (g.seg >= 0) & (dom.seg_tag[np.maximum(g.seg, 0)] == _WANTED)
         los, his, owns = [], [], []
         m = self.m
+        on_ring = hit & (dom.seg_ring[np.maximum(g.seg, 0)] == 1)
+        # cw ring segment k runs from ring0[m-1-k] to ring0[m-2-k]: ccw edge i = m-2-k
+        edge_of = (m - 2 - (g.seg - self._box_segs)) % m
+        # the probes of one trace share their q: cut the edges once per distinct q
+        q_u, q_inv = np.unique(q, axis=0, return_inverse=True)
+        q_inv = q_inv.reshape(-1)
         for i in range(m):
-            # cw ring segment k runs from ring0[m-1-k] to ring0[m-2-k]: ccw edge i = m-2-k
-            sel = hit & (dom.seg_ring[np.maximum(g.seg, 0)] == 1)
-            sel &= ((m - 2 - (g.seg - self._box_segs)) % m) == i
+            sel = on_ring & (edge_of == i)
             if not sel.any():
                 continue
             j = own[sel]
@@ -361,7 +365,10 @@ class Sweeper:
             u0 = ((g.p0[sel] - a) @ e) / ee
             u1 = ((g.p1[sel] - a) @ e) / ee
             ulo, uhi = np.minimum(u0, u1), np.maximum(u0, u1)
-            cells = self._cells(i, q[j])
+            rows = q_inv[j]
+            used, back = np.unique(rows, return_inverse=True)
+            back = back.reshape(-1)
+            cells = [(c0[back], c1[back], ins[back]) for c0, c1, ins in self._cells(i, q_u[used])]
             for c0, c1, ins in cells:
                 lo = np.maximum(ulo, c0)
                 hi = np.minimum(uhi, c1)
