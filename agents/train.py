@@ -14,7 +14,10 @@ constructor arguments plus these keys:
 ``frame_stack: k`` (SB3's ``VecFrameStack``: the policy sees the last ``k`` observations,
 a memory for partially observable tasks); ``normalize: true`` or ``{norm_obs: ..,
 norm_reward: ..}`` (SB3's ``VecNormalize``; its statistics are saved beside each model as
-``<model>_vecnormalize.pkl`` and :func:`agents.policies.load_policy` applies them).
+``<model>_vecnormalize.pkl`` and :func:`agents.policies.load_policy` applies them);
+``eval_env_kwargs`` (merged over ``env_kwargs`` for the periodic evaluations that select
+``best_model``: e.g. ``{scene_pool_seed: 2}`` selects on a validation pool of procedural
+scenes, disjoint from the training pool (seed 0) and the benchmark's test pool (seed 1)).
 
 Command-line values override the file (``--env-kwargs`` is merged over ``env_kwargs``).
 ``--config FILE`` reads another file of the same layout, or a section on its own, or the
@@ -123,6 +126,13 @@ def load_hyperparams(algo: str, env_id: str, config: str | Path | None = None) -
         section.setdefault("env_kwargs", data.get("env_kwargs") or {})
         section.setdefault("n_envs", data.get("n_envs", 1))
         section.setdefault("n_timesteps", data.get("timesteps"))
+        # the meta keys that training records outside ``hyperparams``
+        if (data.get("frame_stack") or 1) > 1:
+            section.setdefault("frame_stack", data["frame_stack"])
+        if data.get("normalize"):
+            section.setdefault("normalize", data.get("normalize_kwargs") or True)
+        if (data.get("eval") or {}).get("env_kwargs"):
+            section.setdefault("eval_env_kwargs", data["eval"]["env_kwargs"])
         return section
     if env_id in data:
         return dict(data[env_id] or {})
@@ -353,6 +363,9 @@ def train(
     if frame_stack < 1:
         raise ValueError(f"frame_stack must be a positive integer, got {frame_stack}")
     norm_kw = _normalize_kwargs(hp.pop("normalize", None), hp.get("gamma"))
+    eval_kw = hp.pop("eval_env_kwargs", None) or {}
+    if not isinstance(eval_kw, dict):
+        raise ValueError(f"eval_env_kwargs must be a mapping of env kwargs, got {eval_kw!r}")
     hyperparams = copy.deepcopy(hp)  # as written in the YAML, for the record
 
     out = Path(out) if out is not None else default_out(algo, env_id, seed)
@@ -376,13 +389,18 @@ def train(
         vec_cls = SubprocVecEnv if vec_env == "subproc" else DummyVecEnv
         venv = make_vec_env(make, n_envs=n_envs, seed=seed, vec_env_cls=vec_cls)
         vec_name = vec_cls.__name__
-    eval_env = make_vec_env(make, n_envs=1, seed=seed + EVAL_SEED_OFFSET, vec_env_cls=DummyVecEnv)
+    # the periodic evaluations (best-model selection) may use other scenes, e.g. a validation
+    # pool: eval_env_kwargs {"scene_pool_seed": 2}
+    make_eval = _make_env_fn(env_id, {**resolved_env_kwargs, **eval_kw}) if eval_kw else make
+    eval_env = make_vec_env(
+        make_eval, n_envs=1, seed=seed + EVAL_SEED_OFFSET, vec_env_cls=DummyVecEnv
+    )
     if norm_kw is not None:
         from stable_baselines3.common.vec_env import VecMonitor, VecNormalize
 
         if vec_env == "batched":  # wrapped like the training env, so the statistics sync
             eval_env.close()
-            eval_env = DummyVecEnv([make])
+            eval_env = DummyVecEnv([make_eval])
             eval_env.seed(seed + EVAL_SEED_OFFSET)
             eval_env = VecMonitor(eval_env)
         venv = VecNormalize(venv, **norm_kw)
@@ -434,7 +452,12 @@ def train(
         "n_envs": n_envs,
         "vec_env": vec_env,
         "torch_threads": int(threads or torch.get_num_threads()),
-        "eval": {"freq": freq, "episodes": n_eval, "seed": seed + EVAL_SEED_OFFSET},
+        "eval": {
+            "freq": freq,
+            "episodes": n_eval,
+            "seed": seed + EVAL_SEED_OFFSET,
+            **({"env_kwargs": eval_kw} if eval_kw else {}),
+        },
         "versions": {
             "sensorplan-gym": package_version(),
             "stable-baselines3": str(stable_baselines3.__version__),

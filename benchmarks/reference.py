@@ -82,10 +82,16 @@ class Entry:
     hp: dict[str, Any] = field(default_factory=dict)
     config: str | None = None
     discrete: bool = False
+    variant: str = ""  # a training-distribution variant, e.g. "notch" (run folder ..._randomnotch_s0)
+
+    @property
+    def key(self) -> str:
+        """The entry's name for ``--only``: ``ppo``, ``ppo-notch``, ..."""
+        return self.name + (f"-{self.variant}" if self.variant else "")
 
     def out(self, seed: int) -> Path:
         env = self.env_id.split("/")[-1].split("-v")[0].lower()
-        return RUNS / f"{self.name}_{env}_random_s{seed}"
+        return RUNS / f"{self.name}_{env}_random{self.variant}_s{seed}"
 
     def command(self, seed: int) -> str:
         """The ``sensorplan train`` command of this entry and seed."""
@@ -110,6 +116,16 @@ class Entry:
 
 GRID: list[Entry] = [
     Entry("ppo", "PPO", NAV, "ppo", 800_000, {**NAV_TRAIN, "random_start": False}, _PPO_NAV_HP),
+    Entry(
+        "ppo",
+        "PPO, L-shaped rooms in training",
+        NAV,
+        "ppo",
+        800_000,
+        {**NAV_TRAIN, "random_start": False, "random_scene_kwargs": {"notch_size": [0.3, 0.75]}},
+        _PPO_NAV_HP,
+        variant="notch",
+    ),
     Entry("ppo", "PPO", REC, "ppo", 800_000, REC_TRAIN),
     Entry("ppo", "PPO", PLACE, "ppo", 300_000, {**PLACE_TRAIN, "shaping": 1.0}, _PPO_PLACE_HP),
     Entry(
@@ -197,11 +213,11 @@ GRID: list[Entry] = [
 def _selected(only: list[str] | None) -> list[Entry]:
     if not only:
         return GRID
-    keys = {f"{e.name}:{e.env_id.split('/')[-1]}" for e in GRID} | {e.name for e in GRID}
+    keys = {f"{e.key}:{e.env_id.split('/')[-1]}" for e in GRID} | {e.key for e in GRID}
     bad = [o for o in only if o not in keys]
     if bad:
         raise SystemExit(f"unknown entries {bad}; choose from {sorted(keys)}")
-    return [e for e in GRID if e.name in only or f"{e.name}:{e.env_id.split('/')[-1]}" in only]
+    return [e for e in GRID if e.key in only or f"{e.key}:{e.env_id.split('/')[-1]}" in only]
 
 
 def train_grid(entries: list[Entry], seeds: list[int]) -> None:

@@ -17,7 +17,7 @@ from benchmarks import reference  # noqa: E402
 
 def test_grid_commands_parse_and_match_their_entries():
     parser = build_parser()
-    seen = set()
+    seen, outs = set(), set()
     for e in reference.GRID:
         args = parser.parse_args(shlex.split(e.command(3))[1:])
         assert args.env == e.env_id and args.algo == e.algo and args.seed == 3
@@ -25,8 +25,10 @@ def test_grid_commands_parse_and_match_their_entries():
         assert args.env_kwargs == e.env_kwargs
         if e.hp:
             assert _hp_overrides(args.hp) == e.hp
-        assert (e.name, e.env_id) not in seen
-        seen.add((e.name, e.env_id))
+        assert (e.key, e.env_id) not in seen
+        seen.add((e.key, e.env_id))
+        assert str(e.out(3)) not in outs  # every entry trains into its own folders
+        outs.add(str(e.out(3)))
         assert e.discrete == (e.env_kwargs.get("action_type") == "discrete")
 
 

@@ -78,3 +78,43 @@ def test_seeds_checkpoints_and_resume(tmp_path, capsys):
     assert PPO.load(tmp_path / "res" / "final_model.zip").num_timesteps == 128 + 64
     assert main(["train", *common, "--resume", str(tmp_path / "nope.zip")]) == 2
     assert "no saved model" in capsys.readouterr().err
+
+
+def test_best_model_selected_on_a_validation_pool_and_config_round_trips(tmp_path):
+    import yaml
+
+    from agents.train import load_hyperparams, train
+
+    kw = dict(
+        timesteps=64,
+        env_kwargs={"scene": "random", "scene_pool_size": 4},
+        progress_bar=False,
+        tensorboard=False,
+        verbose=0,
+        eval_freq=64,
+        eval_episodes=2,
+    )
+    hp = {"n_steps": 32, "batch_size": 32, "n_envs": 2, "frame_stack": 2}
+    # the evaluation env really is built with eval_env_kwargs: a bad one fails there
+    with pytest.raises(TypeError, match="bogus"):
+        train(
+            "sensorplan/Placement-v0",
+            "ppo",
+            out=tmp_path / "bad",
+            hp_overrides={**hp, "eval_env_kwargs": {"bogus": 1}},
+            **kw,
+        )
+    res = train(
+        "sensorplan/Placement-v0",
+        "ppo",
+        out=tmp_path / "val",
+        hp_overrides={**hp, "eval_env_kwargs": {"scene_pool_seed": 2}},
+        **kw,
+    )
+    rec = yaml.safe_load((tmp_path / "val" / "final_model.yaml").read_text())
+    assert rec["eval"]["env_kwargs"] == {"scene_pool_seed": 2}
+    assert rec["env_kwargs"]["scene_pool_size"] == 4 and "scene_pool_seed" not in rec["env_kwargs"]
+    # a resolved config gives back the meta keys training recorded outside ``hyperparams``
+    section = load_hyperparams("ppo", "sensorplan/Placement-v0", res["out"] + "/final_model.yaml")
+    assert section["eval_env_kwargs"] == {"scene_pool_seed": 2}
+    assert section["frame_stack"] == 2 and "normalize" not in section
