@@ -67,6 +67,11 @@ from .weak import weak_visibility
 #: size (about 1e-12): see :func:`swept_shadows`.
 GRID_BITS = 40
 
+#: The stationary shadows (free space minus target minus weak visibility region) are
+#: computed by snap-rounding onto a grid ``2**-SHADOW_BITS`` finer than the union's:
+#: see :meth:`Sweeper.shadow`.
+SHADOW_BITS = 8
+
 __all__ = ["QueryTimeout", "Sweeper", "star_center", "swept_shadows"]
 
 
@@ -148,6 +153,8 @@ class Sweeper:
         self.tol_lab = 1e-8 * self.env.scale
         #: snap-rounding grid of the final union (scene units, a power of two)
         self.grid = snap_grid(self.env.scale)
+        #: snap-rounding grid of the stationary shadows (scene units, a power of two)
+        self.shadow_grid = math.ldexp(self.grid, -SHADOW_BITS)
 
     # ------------------------------------------------------------------ anchors
     def pos(self, ids: np.ndarray, q: np.ndarray) -> np.ndarray:
@@ -207,16 +214,30 @@ class Sweeper:
 
     # --------------------------------------------------------- stationary shadow
     def shadow(self, q: np.ndarray) -> tuple[shapely.Geometry, np.ndarray, np.ndarray]:
-        """Exact shadow S(q) (free space minus target minus the partial region),
-        with the anchor table used to label its edges."""
+        """Shadow S(q) (free space minus target minus the partial region), with the
+        anchor table used to label its edges.
+
+        The overlay is snap-rounded onto ``shadow_grid`` (``2**-SHADOW_BITS`` of the
+        union's grid).  The weak visibility region's fans end on the target at ray hits
+        computed in floating point, so the region's hole around the target is the target
+        with its vertices moved by an ulp or two; GEOS's floating overlay of the target
+        with that nearly coincident hole can assign rings wrongly (an invalid "nested
+        shells" union, then TopologyException "unable to assign free hole to a shell",
+        fuzz seed 506058).  Snap-rounding is robust, and the two snap-roundings together
+        (this one and the union's) move no point by more than ``grid / sqrt(2) * (1 +
+        2**-SHADOW_BITS) < grid``, which ``conservative=True`` covers."""
 
         ring, wanted, ids = self.outline(q)
         area = shapely.Polygon(self.ring0 + q)
+        g = self.shadow_grid
         if not wanted.any():
-            shadow = shapely.difference(self.free, area)
+            shadow = shapely.difference(self.free, area, grid_size=g)
         else:
             reg = weak_visibility(self.env, ring[::-1], np.roll(wanted[::-1], -1), self.eps_aim)
-            shadow = shapely.difference(self.free, shapely.union(reg, area))
+            # areal(): snap-rounding collapses slivers of the union narrower than the grid
+            # into lines, and a snap-rounded overlay refuses mixed-dimension input
+            seen = areal(shapely.union(reg, area, grid_size=g))
+            shadow = shapely.difference(self.free, seen, grid_size=g)
         table = np.vstack([self.env.vert, ring])
         tid = np.concatenate([np.arange(self.n_fixed), ids])
         return polygonal(shadow), table, tid
@@ -227,7 +248,7 @@ class Sweeper:
         out = []
         n = self.n_fixed
         for ring in _rings(shapely.orient_polygons(shadow, exterior_cw=False)):
-            v = np.asarray(ring.coords)[:-1, :2]
+            v = _drop_short(np.asarray(ring.coords)[:-1, :2], self.tol_lab)
             if len(v) < 3:
                 continue
             keys = self._label(v, table, tid)
@@ -558,7 +579,9 @@ class Sweeper:
         core = parts[np.argmax(shapely.area(parts))]
         ring = np.asarray(shapely.orient_polygons(core, exterior_cw=True).exterior.coords)[:-1]
         reg = weak_visibility(self.env, ring, np.ones(len(ring), dtype=bool), self.eps_aim)
-        return polygonal(shapely.difference(self.free, shapely.union(reg, core)))
+        g = self.shadow_grid  # as in shadow(): the region's hole nearly coincides with core
+        seen = areal(shapely.union(reg, core, grid_size=g))
+        return polygonal(shapely.difference(self.free, seen, grid_size=g))
 
     def _trace_many(self, edges: list, ta: float, tb: float, q0, dq) -> tuple[list, list]:
         """Areas swept by moving shadow edges found at sample ``ta`` while they live
@@ -767,6 +790,21 @@ def _rings(g: shapely.Geometry) -> list:
         out.append(poly.exterior)
         out.extend(poly.interiors)
     return out
+
+
+def _drop_short(v: np.ndarray, length: float) -> np.ndarray:
+    """The closed ring ``v`` (n, 2) without the vertices that end an edge shorter than
+    ``length`` (scene units): such an edge is a corner split by the overlay's rounding
+    (snap-rounding nodes a corner at a hot pixel, floating overlay leaves ulp-sized
+    edges), and its line is not determined to within ``length``, so it cannot be
+    labelled and would hide its neighbours from the tracing."""
+    keep = [0]
+    for i in range(1, len(v)):
+        if np.abs(v[i] - v[keep[-1]]).max() >= length:
+            keep.append(i)
+    while len(keep) > 1 and np.abs(v[keep[-1]] - v[0]).max() < length:
+        keep.pop()
+    return v[keep]
 
 
 def _rot(v: np.ndarray) -> np.ndarray:
