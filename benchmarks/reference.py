@@ -129,6 +129,16 @@ GRID: list[Entry] = [
     Entry("ppo", "PPO", REC, "ppo", 800_000, REC_TRAIN),
     Entry("ppo", "PPO", PLACE, "ppo", 300_000, {**PLACE_TRAIN, "shaping": 1.0}, _PPO_PLACE_HP),
     Entry(
+        "ppo",
+        "PPO, 4,096 training scenes",
+        PLACE,
+        "ppo",
+        300_000,
+        {**PLACE_TRAIN, "shaping": 1.0, "scene_pool_size": 4096},
+        _PPO_PLACE_HP,
+        variant="pool4096",
+    ),
+    Entry(
         "ppofs4",
         "PPO + 4 stacked frames (memory)",
         REC,
