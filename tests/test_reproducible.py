@@ -66,3 +66,10 @@ def test_shipped_config_trains_bit_identically_twice(cfg, tmp_path):
     pa, pb = (cls.load(r["final_model"]).policy.state_dict() for r in runs)
     assert pa.keys() == pb.keys()
     assert all(torch.equal(pa[k], pb[k]) for k in pa)
+    # the re-run sees what the shipped policy saw: same env kwargs and preprocessing
+    again = yaml.safe_load((tmp_path / "a" / "final_model.yaml").read_text())
+    for key in ("env_kwargs", "frame_stack", "normalize", "policy"):
+        assert again[key] == rec[key], key
+    assert cls.load(runs[0]["final_model"]).observation_space == cls.load(
+        str(cfg.with_suffix(".zip"))
+    ).observation_space
