@@ -10,7 +10,10 @@
     runs ``sensorplan benchmark`` (:func:`agents.benchmark.benchmark`) per env on the splits
     ``train``, ``test`` (held-out procedural scenes) and ``ood`` (every bundled scene, never
     trained on), with the oracle, the random policy and every trained model found; results
-    in ``runs/reference/<env>[-discrete]/``.
+    in ``runs/reference/<env>[-discrete]/``.  ``--only NAME[:Env-v0] ...`` evaluates just
+    those entries' models and ``--new`` just the models not evaluated yet (into
+    ``<env>[-discrete]/models-<entry>/``; ``report`` merges them, a newer result of a model
+    replacing an older one).
 ``python -m benchmarks.reference report [--update-results]``
     the markdown table per env: success per split, the interquartile mean over training
     seeds with its stratified-bootstrap 95 % interval (:mod:`agents.stats`), the normalized
@@ -82,7 +85,8 @@ class Entry:
     hp: dict[str, Any] = field(default_factory=dict)
     config: str | None = None
     discrete: bool = False
-    variant: str = ""  # a training-distribution variant, e.g. "notch" (run folder ..._randomnotch_s0)
+    #: a training-distribution variant, e.g. "notch" (run folder ..._randomnotch_s0)
+    variant: str = ""
 
     @property
     def key(self) -> str:
@@ -269,27 +273,69 @@ def _group_dir(env_id: str, discrete: bool) -> Path:
     return OUT / (env_id.split("/")[-1] + ("-discrete" if discrete else ""))
 
 
-def evaluate_grid(episodes: int, seed: int = 0, envs: list[str] | None = None) -> None:
+def _result_files(env_id: str, discrete: bool) -> list[Path]:
+    """The benchmark results of one env and action type, oldest first: the full evaluation
+    (``<group>/benchmark.json``, with the baselines) and the incremental ones of
+    ``evaluate --only`` (``<group>/models-<entry>/benchmark.json``)."""
+    g = _group_dir(env_id, discrete)
+    extra = sorted(g.glob("models-*/benchmark.json"), key=lambda f: f.stat().st_mtime)
+    return ([g / "benchmark.json"] if (g / "benchmark.json").is_file() else []) + extra
+
+
+def _evaluated(env_id: str, discrete: bool) -> set[str]:
+    return {
+        p["spec"]
+        for f in _result_files(env_id, discrete)
+        for r in json.loads(f.read_text())["splits"].values()
+        for p in r["policies"]
+    }
+
+
+def evaluate_grid(
+    episodes: int,
+    seed: int = 0,
+    envs: list[str] | None = None,
+    only: list[Entry] | None = None,
+    new: bool = False,
+) -> None:
     """``sensorplan benchmark`` per env (and per action type) with every trained model;
-    ``envs``: only these env ids."""
+    ``envs``: only these env ids.  ``only``: only these entries' models, without the
+    baselines, into ``<group>/models-<entry>/`` (:func:`report` merges them; a model's
+    episodes do not depend on which other policies are evaluated with it); ``new``: only
+    models not evaluated yet."""
     from agents.benchmark import benchmark
 
     for env_id in envs or (PLACE, REC, NAV):
         for discrete in (False, True):
             entries = [e for e in GRID if e.env_id == env_id and e.discrete == discrete]
-            models = _models(entries)
-            if not models:
-                continue
-            base = ["random"] if discrete else ["oracle", "random"]
             kw = dict(EVAL_KWARGS[env_id], **({"action_type": "discrete"} if discrete else {}))
-            benchmark(
-                env_id,
-                base + models,
-                episodes=episodes,
-                seed=seed,
-                env_kwargs=kw,
-                out=_group_dir(env_id, discrete),
-            )
+            done = _evaluated(env_id, discrete) if new else set()
+            if only is None and not new:
+                models = _models(entries)
+                if models:
+                    base = ["random"] if discrete else ["oracle", "random"]
+                    benchmark(
+                        env_id,
+                        base + models,
+                        episodes=episodes,
+                        seed=seed,
+                        env_kwargs=kw,
+                        out=_group_dir(env_id, discrete),
+                    )
+                continue
+            for e in entries:
+                if only is not None and e not in only:
+                    continue
+                models = [m for m in _models([e]) if m not in done]
+                if models:
+                    benchmark(
+                        env_id,
+                        models,
+                        episodes=episodes,
+                        seed=seed,
+                        env_kwargs=kw,
+                        out=_group_dir(env_id, discrete) / f"models-{e.key}",
+                    )
 
 
 def _cell(rates: list[float], seed: int = 0) -> str:
@@ -314,14 +360,15 @@ def report() -> str:
         base: dict[tuple[str, str], float] = {}
         path: dict[tuple[str, str], float] = {}
         for discrete in (False, True):
-            f = _group_dir(env_id, discrete) / "benchmark.json"
-            if not f.is_file():
-                continue
-            res = json.loads(f.read_text())
-            for sp, r in res["splits"].items():
-                if sp not in splits:
-                    splits.append(sp)
-                for p in r["policies"]:
+            merged: dict[str, dict] = {}  # split -> spec -> policy result (latest file wins)
+            for f in _result_files(env_id, discrete):
+                for sp, r in json.loads(f.read_text())["splits"].items():
+                    if sp not in splits:
+                        splits.append(sp)
+                    for p in r["policies"]:
+                        merged.setdefault(sp, {})[p["spec"]] = p
+            for sp, by_spec in merged.items():
+                for p in by_spec.values():
                     if p["kind"] in ("oracle", "random"):
                         key = p["kind"] + (" (discrete)" if discrete else "")
                         base[(key, sp)] = p["success_rate"]
@@ -397,6 +444,10 @@ def main(argv: list[str] | None = None) -> int:
     ev = sub.add_parser("evaluate", help="benchmark every trained model on every split")
     ev.add_argument("--episodes", type=int, default=100)
     ev.add_argument("--envs", nargs="+", default=None, help="only these env ids")
+    ev.add_argument(
+        "--only", nargs="+", default=None, help="only these entries' models (NAME or NAME:Env-v0)"
+    )
+    ev.add_argument("--new", action="store_true", help="only models not evaluated yet")
     rp = sub.add_parser("report", help="the markdown tables")
     rp.add_argument("--update-results", action="store_true")
     args = ap.parse_args(argv)
@@ -409,7 +460,12 @@ def main(argv: list[str] | None = None) -> int:
             return 0
         train_grid(entries, args.seeds)
     elif args.cmd == "evaluate":
-        evaluate_grid(args.episodes, envs=args.envs)
+        evaluate_grid(
+            args.episodes,
+            envs=args.envs,
+            only=_selected(args.only) if args.only else None,
+            new=args.new,
+        )
     else:
         text = report()
         OUT.mkdir(parents=True, exist_ok=True)

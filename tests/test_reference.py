@@ -57,3 +57,49 @@ def test_report_tabulates_iqm_and_normalized_score(tmp_path, monkeypatch):
     # normalized (x - 0.2) / 0.8 -> IQM of the middle two = (0.75 + 0.875) / 2
     assert cells[4].startswith("0.81 [")
     assert "| oracle | — | — | 1.00 | 1.00 |" in text
+
+
+def test_report_merges_incremental_evaluations(tmp_path, monkeypatch):
+    """``evaluate --only/--new`` writes models-<entry>/benchmark.json beside the full
+    evaluation; the report adds its models and a newer result replaces an older one."""
+    import os
+
+    monkeypatch.setattr(reference, "OUT", tmp_path)
+    monkeypatch.setattr(reference, "RUNS", tmp_path / "runs")
+    ppo = next(e for e in reference.GRID if e.name == "ppo" and e.env_id == reference.PLACE)
+    sac = next(e for e in reference.GRID if e.name == "sac" and e.env_id == reference.PLACE)
+
+    def pol(kind, spec, sr):
+        return {"kind": kind, "spec": spec, "success_rate": sr, "mean_path_length": 0.0}
+
+    def spec(e, s):
+        return str(e.out(s) / "best_model.zip")
+
+    full = {
+        "policies": [pol("oracle", "oracle", 1.0), pol("random", "random", 0.2)]
+        + [pol("model", spec(ppo, s), 0.5) for s in range(2)]
+    }
+    d = tmp_path / "Placement-v0"
+    (d / "models-sac").mkdir(parents=True)
+    (d / "benchmark.json").write_text(json.dumps({"splits": {"test": full}}))
+    newer = {"policies": [pol("model", spec(sac, s), 0.9) for s in range(3)]}
+    newer["policies"].append(pol("model", spec(ppo, 1), 0.7))  # re-evaluated: replaces 0.5
+    f = d / "models-sac" / "benchmark.json"
+    f.write_text(json.dumps({"splits": {"test": newer}}))
+    t = (d / "benchmark.json").stat().st_mtime
+    os.utime(f, (t + 10, t + 10))
+    assert reference._evaluated(reference.PLACE, False) == {
+        "oracle",
+        "random",
+        *(spec(ppo, s) for s in range(2)),
+        *(spec(sac, s) for s in range(3)),
+    }
+    text = reference.report()
+    rows = {
+        line.split("|")[1].strip(): [c.strip() for c in line.strip("|").split("|")]
+        for line in text.splitlines()
+        if line.startswith("| ")
+    }
+    assert rows["SAC"][1] == "3" and rows["SAC"][3].startswith("0.90 [")
+    assert rows["PPO"][1] == "2" and rows["PPO"][3].startswith("0.60 [")  # IQM of 0.5, 0.7
+    assert "| oracle | — | — | 1.00 |" in text
