@@ -208,6 +208,16 @@ GRID: list[Entry] = [
     Entry("sac", "SAC", REC, "sac", 200_000, REC_TRAIN),
     Entry(
         "sac",
+        "SAC, 1 gradient step per env step",
+        REC,
+        "sac",
+        200_000,
+        REC_TRAIN,
+        {"gradient_steps": 8},
+        variant="utd1",
+    ),
+    Entry(
+        "sac",
         "SAC",
         NAV,
         "sac",
@@ -220,6 +230,23 @@ GRID: list[Entry] = [
             "n_eval_episodes": 100,
             "policy_kwargs": {"net_arch": [128, 128]},
         },
+    ),
+    Entry(
+        "sac",
+        "SAC, 1 gradient step per env step",
+        NAV,
+        "sac",
+        200_000,
+        NAV_TRAIN,
+        {
+            "n_envs": 8,
+            "vec_env": "batched",
+            "gradient_steps": 8,
+            "eval_freq": 50_000,
+            "n_eval_episodes": 100,
+            "policy_kwargs": {"net_arch": [128, 128]},
+        },
+        variant="utd1",
     ),
 ]
 
