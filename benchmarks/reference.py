@@ -71,6 +71,14 @@ _PPO_PLACE_HP = {
     "n_eval_episodes": 200,
 }
 
+_SAC_NAV_HP = {
+    "n_envs": 8,
+    "vec_env": "batched",
+    "eval_freq": 50_000,
+    "n_eval_episodes": 100,
+    "policy_kwargs": {"net_arch": [128, 128]},
+}
+
 
 @dataclass(frozen=True)
 class Entry:
@@ -223,13 +231,7 @@ GRID: list[Entry] = [
         "sac",
         200_000,
         NAV_TRAIN,
-        {
-            "n_envs": 8,
-            "vec_env": "batched",
-            "eval_freq": 50_000,
-            "n_eval_episodes": 100,
-            "policy_kwargs": {"net_arch": [128, 128]},
-        },
+        _SAC_NAV_HP,
     ),
     Entry(
         "sac",
@@ -238,14 +240,7 @@ GRID: list[Entry] = [
         "sac",
         200_000,
         NAV_TRAIN,
-        {
-            "n_envs": 8,
-            "vec_env": "batched",
-            "gradient_steps": 8,
-            "eval_freq": 50_000,
-            "n_eval_episodes": 100,
-            "policy_kwargs": {"net_arch": [128, 128]},
-        },
+        {**_SAC_NAV_HP, "gradient_steps": 8},
         variant="utd1",
     ),
 ]
