@@ -283,11 +283,12 @@ def train_grid(entries: list[Entry], seeds: list[int]) -> None:
 
 
 def _models(entries: list[Entry]) -> list[str]:
+    """The best models of the finished runs (``final_model.zip`` written) of ``entries``."""
     return [
         str(e.out(s) / "best_model.zip")
         for e in entries
         for s in range(100)
-        if (e.out(s) / "best_model.zip").is_file()
+        if (e.out(s) / "best_model.zip").is_file() and (e.out(s) / "final_model.zip").is_file()
     ]
 
 
