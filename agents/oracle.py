@@ -211,14 +211,16 @@ class _Driver:
                 self.stuck = 0
         self.last_xy = pos
         v = env.max_speed
+        box = getattr(env, "speed_limit", "box") == "box"
         move = np.zeros(2)
         if self.waypoints:
-            # the action square allows sqrt(2) * v along the robot's diagonals: go as far
-            # along the current leg as the square permits (never past its corner)
+            # the action square ("box" speed limit) allows sqrt(2) * v along the robot's
+            # diagonals: go as far along the current leg as the limit permits (never past
+            # its corner); a "disc" limit allows v in every direction
             d = self.waypoints[0] - pos
             dist = float(np.hypot(*d))
             rel = math.atan2(d[1], d[0]) - psi
-            reach = v / max(abs(math.cos(rel)), abs(math.sin(rel)), 1e-12)
+            reach = v / max(abs(math.cos(rel)), abs(math.sin(rel)), 1e-12) if box else v
             if dist <= reach:
                 move = d
                 self.waypoints.pop(0)
@@ -229,7 +231,7 @@ class _Driver:
             float(np.hypot(*(b - a)))
             for a, b in zip([pos + move, *self.waypoints[:-1]], self.waypoints, strict=False)
         )
-        if self.waypoints and left > math.sqrt(2) * v:
+        if box and self.waypoints and left > math.sqrt(2) * v:
             # still travelling: turn so that the next leg runs along a diagonal
             nxt = self.waypoints[0] - (pos + move)
             travel = math.atan2(nxt[1], nxt[0])

@@ -3,6 +3,7 @@ shaping, and the oracle under declare_hold."""
 
 from __future__ import annotations
 
+import math
 import warnings
 
 import gymnasium as gym
@@ -143,6 +144,55 @@ def test_oracle_with_declare_hold():
     assert ok == 3
     with pytest.raises(TypeError, match="continuous"):
         OraclePolicy(gym.make("sensorplan/Navigate-v0", action_type="discrete"))
+
+
+@pytest.mark.parametrize("env_id", ["sensorplan/Navigate-v0", "sensorplan/Recognize-v0"])
+def test_speed_limit_disc_caps_every_direction(env_id):
+    """``speed_limit="box"`` moves sqrt(2) * max_speed along a diagonal; ``"disc"`` caps the
+    translation's length at max_speed and leaves actions inside the disc alone."""
+    moved = {}
+    for limit in ("box", "disc"):
+        env = gym.make(env_id, speed_limit=limit, max_speed=0.05)
+        for a in ([1, 1], [0.6, -0.8], [0.3, 0.2], [-1, 0.5]):
+            env.reset(seed=0)
+            p0 = np.array(env.unwrapped.pose[:2])
+            act = np.zeros(env.action_space.shape, dtype=np.float32)
+            act[:2] = a
+            info = env.step(act)[4]
+            assert not info["collided"]
+            moved[limit, tuple(a)] = np.hypot(*(np.array(env.unwrapped.pose[:2]) - p0)) / 0.05
+    assert moved["box", (1, 1)] == pytest.approx(math.sqrt(2))
+    assert moved["disc", (1, 1)] == pytest.approx(1.0)
+    assert moved["box", (-1, 0.5)] == pytest.approx(math.hypot(1, 0.5))
+    assert moved["disc", (-1, 0.5)] == pytest.approx(1.0)
+    for a in ((0.6, -0.8), (0.3, 0.2)):  # inside the disc: the same motion under both
+        assert moved["disc", a] == pytest.approx(moved["box", a]) == pytest.approx(math.hypot(*a))
+    with pytest.raises(ValueError, match="speed_limit"):
+        gym.make(env_id, speed_limit="square")
+
+
+def test_oracle_under_disc_speed_limit_drives_the_same_path():
+    """The oracle knows the limit: under ``"disc"`` it drives the same shortest path in more
+    steps (no diagonal shortcut) and still succeeds."""
+    from agents.oracle import OraclePolicy
+
+    out = {}
+    for limit in ("box", "disc"):
+        env = gym.make("sensorplan/Navigate-v0", speed_limit=limit)
+        pol = OraclePolicy(env)
+        obs, _ = env.reset(seed=0)
+        pol.reset()
+        xy, path = np.array(env.unwrapped.pose[:2]), 0.0
+        for steps in range(1, 201):
+            obs, r, term, trunc, info = env.step(pol.predict(obs)[0])
+            nxt = np.array(info["pose"][:2])
+            path, xy = path + float(np.hypot(*(nxt - xy))), nxt
+            if term or trunc:
+                break
+        assert info["is_success"]
+        out[limit] = (steps, path)
+    assert out["disc"][0] > out["box"][0]
+    assert out["disc"][1] == pytest.approx(out["box"][1], rel=0.02)
 
 
 def test_map_evidence_points_at_the_right_region():

@@ -75,9 +75,10 @@ from ..core.sensor import NOISE_BOUND, RangeSensor
 from ..core.sim import BLOCK, BatchSim
 from ..core.world import World, WorldConfig, get_world, load_scene
 
-__all__ = ["RobotBatch", "SensorPlanBatch", "SensorPlanEnv"]
+__all__ = ["SPEED_LIMITS", "RobotBatch", "SensorPlanBatch", "SensorPlanEnv"]
 
 Start = tuple[float, float, float]
+SPEED_LIMITS = ("box", "disc")  # RobotBatch's ``speed_limit``
 
 
 def _start_pose(world: World, rng: np.random.Generator, needs_start: bool) -> Start:
@@ -351,6 +352,12 @@ class RobotBatch(SensorPlanBatch):
     target in Recognize): on contact the robot stops there (it never passes through), and
     ``info["collided"]`` is True.  Out-of-range components are clipped to [-1, 1].
 
+    ``speed_limit`` says how fast the robot may translate: ``"box"`` (the v0 default) limits
+    ``forward`` and ``lateral`` separately, so a diagonal action moves ``sqrt(2) * max_speed``;
+    ``"disc"`` limits the translation's length to ``max_speed`` in every direction (an action
+    whose ``(forward, lateral)`` has norm above 1 is scaled to norm 1), so that the fewest
+    steps are also the shortest path.
+
     ``random_start=True`` draws every episode's start pose from the env's ``np_random``: a
     uniform free position that does not recognize yet, in a part of the free space from
     which the recognizable region is reachable, with a uniform heading (default: the
@@ -365,10 +372,14 @@ class RobotBatch(SensorPlanBatch):
         max_speed: float | None = None,
         max_turn: float = math.pi / 8,
         random_start: bool = False,
+        speed_limit: str = "box",
         **kwargs,
     ) -> None:
         if not isinstance(random_start, bool):
             raise ValueError(f"random_start must be True or False, got {random_start!r}")
+        if speed_limit not in SPEED_LIMITS:
+            raise ValueError(f"speed_limit must be one of {SPEED_LIMITS}, got {speed_limit!r}")
+        self.speed_limit = speed_limit
         for name, v in (("max_speed", max_speed), ("max_turn", max_turn)):
             if v is not None and (
                 not isinstance(v, (int, float)) or not math.isfinite(v) or v <= 0
@@ -435,6 +446,10 @@ class RobotBatch(SensorPlanBatch):
 
     def move(self, act: np.ndarray, idx: np.ndarray) -> np.ndarray:
         """Drive sub-environments ``idx`` and read their sensors; returns ``collided``."""
+        if self.speed_limit == "disc":
+            norm = np.hypot(act[:, 0], act[:, 1])
+            act = act.copy()
+            act[:, :2] /= np.maximum(norm, 1.0)[:, None]
         col = self.drive(act, idx, self.max_turn)
         self.collided[idx] = col
         self.sense(idx)

@@ -122,7 +122,8 @@ class NavigateEnv(SensorPlanEnv):
     | 1     | lateral | -1  | 1   | ``max_speed * a`` to the robot's left (robot frame) |
     | 2     | turn    | -1  | 1   | ``max_turn * a`` radians, counter-clockwise         |
 
-    ``max_speed`` defaults to 3 % of the scene diameter per step, ``max_turn`` to pi/8.  The
+    ``max_speed`` defaults to 3 % of the scene diameter per step, ``max_turn`` to pi/8
+    (``speed_limit="disc"`` scales a ``(forward, lateral)`` of norm above 1 to norm 1).  The
     robot translates first, swept against walls and obstacles (a collision stops it at the
     contact, ``info["collided"]``), then turns.  Out-of-range values are clipped; NaN/inf or
     a wrong shape raise ``ValueError``.  ``action_type="discrete"``: ``Discrete(7)``: 0 stay,
@@ -202,7 +203,9 @@ class NavigateEnv(SensorPlanEnv):
 
     Navigate's own: ``step_cost`` (0.01), ``success_bonus`` (1.0), ``shaping`` (0.0),
     ``max_speed`` (scene units per step; ``None``: 3 % of the diameter), ``max_turn`` (pi/8
-    radians per step), ``random_start`` (False).  ``map_ranges`` / ``map_evidence`` /
+    radians per step), ``random_start`` (False), ``speed_limit`` (``"box"``: forward and
+    lateral each up to ``max_speed``, so diagonals move sqrt(2) times as far; ``"disc"``: at
+    most ``max_speed`` in every direction).  ``map_ranges`` / ``map_evidence`` /
     ``sensor_fov`` (False) add the observation entries above (``obs_type="vector"`` only).
     Common to all tasks (details: ``help(sensorplan_gym.envs.base)``):
 

@@ -318,7 +318,8 @@ class RecognizeEnv(SensorPlanEnv):
 
     Recognize's own: ``step_cost`` (0.01), ``shaping`` (0.0), ``declare_hold`` (1, a positive
     integer), ``max_speed`` (``None``: 3 % of the diameter per step), ``max_turn`` (pi/8),
-    ``random_start`` (False).  ``map_ranges`` / ``map_evidence`` / ``sensor_fov`` (False) add
+    ``random_start`` (False), ``speed_limit`` (``"box"`` | ``"disc"``, as in Navigate-v0).
+    ``map_ranges`` / ``map_evidence`` / ``sensor_fov`` (False) add
     the observation entries above (``obs_type="vector"`` only).
     Common to all tasks (details: ``help(sensorplan_gym.envs.base)``):
 
