@@ -182,13 +182,16 @@ def test_oracle_under_disc_speed_limit_drives_the_same_path():
         pol = OraclePolicy(env)
         obs, _ = env.reset(seed=0)
         pol.reset()
-        xy, path = np.array(env.unwrapped.pose[:2]), 0.0
-        for steps in range(1, 201):
+        xy, path, steps, done = np.array(env.unwrapped.pose[:2]), 0.0, 0, False
+        while not done:
             obs, r, term, trunc, info = env.step(pol.predict(obs)[0])
             nxt = np.array(info["pose"][:2])
-            path, xy = path + float(np.hypot(*(nxt - xy))), nxt
-            if term or trunc:
-                break
+            path, xy, steps, done = (
+                path + float(np.hypot(*(nxt - xy))),
+                nxt,
+                steps + 1,
+                term or trunc,
+            )
         assert info["is_success"]
         out[limit] = (steps, path)
     assert out["disc"][0] > out["box"][0]

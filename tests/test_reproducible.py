@@ -70,6 +70,7 @@ def test_shipped_config_trains_bit_identically_twice(cfg, tmp_path):
     again = yaml.safe_load((tmp_path / "a" / "final_model.yaml").read_text())
     for key in ("env_kwargs", "frame_stack", "normalize", "policy"):
         assert again[key] == rec[key], key
-    assert cls.load(runs[0]["final_model"]).observation_space == cls.load(
-        str(cfg.with_suffix(".zip"))
-    ).observation_space
+    assert (
+        cls.load(runs[0]["final_model"]).observation_space
+        == cls.load(str(cfg.with_suffix(".zip"))).observation_space
+    )
