@@ -357,8 +357,19 @@ def evaluate_grid(
                         episodes=episodes,
                         seed=seed,
                         env_kwargs=kw,
-                        out=_group_dir(env_id, discrete) / f"models-{e.key}",
+                        out=_models_dir(_group_dir(env_id, discrete), e.key, new),
                     )
+
+
+def _models_dir(group: Path, key: str, new: bool) -> Path:
+    """Where ``evaluate --only/--new`` writes one entry's models: ``models-<key>``; with
+    ``new`` (only some of the entry's models) the first of ``models-<key>``,
+    ``models-<key>.2``, ... without results, so that no earlier result is overwritten."""
+    d, k = group / f"models-{key}", 1
+    while new and (d / "benchmark.json").is_file():
+        k += 1
+        d = group / f"models-{key}.{k}"
+    return d
 
 
 def _cell(rates: list[float], seed: int = 0) -> str:

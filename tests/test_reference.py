@@ -103,3 +103,18 @@ def test_report_merges_incremental_evaluations(tmp_path, monkeypatch):
     assert rows["SAC"][1] == "3" and rows["SAC"][3].startswith("0.90 [")
     assert rows["PPO"][1] == "2" and rows["PPO"][3].startswith("0.60 [")  # IQM of 0.5, 0.7
     assert "| oracle | — | — | 1.00 |" in text
+
+
+def test_new_evaluations_never_overwrite_earlier_ones(tmp_path):
+    """``evaluate --new`` run twice for one entry (seed 0, later seeds 1-4) keeps both."""
+    d = reference._models_dir(tmp_path, "sac-utd1", new=True)
+    assert d == tmp_path / "models-sac-utd1"
+    d.mkdir()
+    (d / "benchmark.json").write_text("{}")
+    d2 = reference._models_dir(tmp_path, "sac-utd1", new=True)
+    assert d2 == tmp_path / "models-sac-utd1.2"
+    d2.mkdir()
+    (d2 / "benchmark.json").write_text("{}")
+    assert reference._models_dir(tmp_path, "sac-utd1", new=True).name == "models-sac-utd1.3"
+    # --only without --new evaluates all the entry's models: it replaces models-<key>
+    assert reference._models_dir(tmp_path, "sac-utd1", new=False) == d
