@@ -171,6 +171,30 @@ def test_speed_limit_disc_caps_every_direction(env_id):
         gym.make(env_id, speed_limit="square")
 
 
+def test_disc_speed_limit_vector_env_equals_single():
+    """The batched step applies ``speed_limit="disc"`` exactly as the single env does."""
+    kw = {"speed_limit": "disc", "scene": "random"}
+    v = gym.make_vec(
+        "sensorplan/Navigate-v0", num_envs=3, vectorization_mode="vector_entry_point", **kw
+    )
+    s = [gym.make("sensorplan/Navigate-v0", **kw) for _ in range(3)]
+    obs, _ = v.reset(seed=11)
+    for i, e in enumerate(s):
+        assert np.array_equal(obs[i], e.reset(seed=11 + i)[0])
+    rng = np.random.default_rng(2)
+    for _ in range(25):
+        a = rng.uniform(-1.5, 1.5, (3, 3)).astype(np.float32)
+        obs, r, term, trunc, _ = v.step(a)
+        for i, e in enumerate(s):
+            o, ri, ti, tri, _ = e.step(a[i])
+            if ti or tri:
+                o, _ = e.reset()  # the vector env autoresets on its next step
+                break
+            assert np.array_equal(o, obs[i]) and ri == r[i]
+        if (term | trunc).any():
+            break
+
+
 def test_oracle_under_disc_speed_limit_drives_the_same_path():
     """The oracle knows the limit: under ``"disc"`` it drives the same shortest path in more
     steps (no diagonal shortcut) and still succeeds."""
