@@ -57,24 +57,31 @@ def test_discrete_motions_are_the_table():
         gym.make("sensorplan/Navigate-v0", action_type="mixed")
 
 
-def test_discrete_vector_env_equals_single():
-    v = gym.make_vec(
-        "sensorplan/Recognize-v0",
-        num_envs=2,
-        action_type="discrete",
-        vectorization_mode="vector_entry_point",
-    )
-    s = [gym.make("sensorplan/Recognize-v0", action_type="discrete") for _ in range(2)]
-    obs, _ = v.reset(seed=5)
+def _assert_vector_env_equals_single(env_id, actions, seed, **kw):
+    """Step ``make_vec(..., "vector_entry_point")`` and one single env per sub-env with the same
+    actions (``actions``: [step, env]); every observation and reward must agree.  Returns the
+    vector env's ``terminated | truncated`` per step."""
+    n = actions.shape[1]
+    v = gym.make_vec(env_id, num_envs=n, vectorization_mode="vector_entry_point", **kw)
+    s = [gym.make(env_id, **kw) for _ in range(n)]
+    obs, _ = v.reset(seed=seed)
     for i, e in enumerate(s):
-        assert np.array_equal(obs[i], e.reset(seed=5 + i)[0])
-    rng = np.random.default_rng(0)
-    for _ in range(30):
-        a = rng.integers(0, 7, 2)
-        obs, r, *_ = v.step(a)
+        assert np.array_equal(obs[i], e.reset(seed=seed + i)[0])
+    ends = []
+    for a in actions:
+        obs, r, term, trunc, _ = v.step(a)
+        ends.append(term | trunc)
         for i, e in enumerate(s):
-            o, ri, *_ = e.step(int(a[i]))
+            o, ri, *_ = e.step(a[i])
             assert np.array_equal(o, obs[i]) and ri == r[i]
+    return np.array(ends)
+
+
+def test_discrete_vector_env_equals_single():
+    actions = np.random.default_rng(0).integers(0, 7, (30, 2))
+    _assert_vector_env_equals_single(
+        "sensorplan/Recognize-v0", actions, seed=5, action_type="discrete"
+    )
 
 
 def test_map_ranges_reveal_the_target():
@@ -175,21 +182,9 @@ def test_disc_speed_limit_vector_env_equals_single():
     """The batched step applies ``speed_limit="disc"`` exactly as the single env does."""
     kw = {"speed_limit": "disc", "scene": "random", "min_start_distance": 0.35}
     kw["max_scene_tries"] = 200  # starts far from the region: 25 steps without an episode end
-    v = gym.make_vec(
-        "sensorplan/Navigate-v0", num_envs=3, vectorization_mode="vector_entry_point", **kw
-    )
-    s = [gym.make("sensorplan/Navigate-v0", **kw) for _ in range(3)]
-    obs, _ = v.reset(seed=11)
-    for i, e in enumerate(s):
-        assert np.array_equal(obs[i], e.reset(seed=11 + i)[0])
-    rng = np.random.default_rng(2)
-    for _ in range(25):
-        a = rng.uniform(-1.5, 1.5, (3, 3)).astype(np.float32)
-        obs, r, term, trunc, _ = v.step(a)
-        assert not (term | trunc).any()
-        for i, e in enumerate(s):
-            o, ri, *_ = e.step(a[i])
-            assert np.array_equal(o, obs[i]) and ri == r[i]
+    actions = np.random.default_rng(2).uniform(-1.5, 1.5, (25, 3, 3)).astype(np.float32)
+    ends = _assert_vector_env_equals_single("sensorplan/Navigate-v0", actions, seed=11, **kw)
+    assert not ends.any()
 
 
 def test_oracle_under_disc_speed_limit_drives_the_same_path():
