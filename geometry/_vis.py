@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 import shapely
 
+from . import _libm
 from . import visindex as _visindex
 from ._shapes import cross
 
@@ -66,10 +67,10 @@ class Domain:
     def vert_wedge(self) -> np.ndarray:
         """(V, 2) free wedge ``(start, width)`` at every vertex: counter-clockwise
         from the direction of the next vertex to that of the previous one."""
-        a = np.arctan2(
+        a = _libm.atan2(
             self.vert_next[:, 1] - self.vert[:, 1], self.vert_next[:, 0] - self.vert[:, 0]
         )
-        b = np.arctan2(
+        b = _libm.atan2(
             self.vert_prev[:, 1] - self.vert[:, 1], self.vert_prev[:, 0] - self.vert[:, 0]
         )
         w = (b - a) % TAU
@@ -281,8 +282,8 @@ def gaps_many(
                 w1[:, 0] + w1[:, 1],
                 w2[:, 0],
                 w2[:, 0] + w2[:, 1],
-                np.arctan2(along[:, 1], along[:, 0]),
-                np.arctan2(-along[:, 1], -along[:, 0]),
+                _libm.atan2(along[:, 1], along[:, 0]),
+                _libm.atan2(-along[:, 1], -along[:, 0]),
             ],
             axis=1,
         )
@@ -300,7 +301,7 @@ def gaps_many(
             open_ &= np.isnan(w0) | (((mid - w0) % TAU) < w[owner, 1])
     ax, ay = along[owner, 0], along[owner, 1]
     with np.errstate(invalid="ignore"):
-        open_ &= np.isnan(ax) | (ax * np.sin(mid) - ay * np.cos(mid) >= 0)
+        open_ &= np.isnan(ax) | (ax * _libm.sin(mid) - ay * _libm.cos(mid) >= 0)
     qo = q[owner]
     seg = np.full(len(mid), -1, dtype=np.int64)
     idx = np.flatnonzero(open_)
@@ -343,7 +344,7 @@ def _sorted_gaps(
     hi`` (flat, radians).  :func:`geometry.visindex.sorted_gaps` is the compiled twin."""
     n = len(q)
     d = vert[None, :, :] - q[:, None, :]
-    a = np.arctan2(d[..., 1], d[..., 0])
+    a = _libm.atan2(d[..., 1], d[..., 0])
     if not interior:
         a = np.where(np.abs(d).max(axis=2) > tol, a, np.nan)
     ang = np.concatenate([a, crit], axis=1)
@@ -377,7 +378,7 @@ def _first_hits(dom: Domain, q: np.ndarray, phi: np.ndarray, *, brute: bool = Fa
             j[lost] = _first_hits(dom, qb[lost], phi[lost], brute=True)
         return j
     q = np.broadcast_to(q, (len(phi), 2))
-    dx, dy = np.cos(phi), np.sin(phi)
+    dx, dy = _libm.cos(phi), _libm.sin(phi)
     x0, y0 = dom.seg[:, 0], dom.seg[:, 1]
     ex, ey = dom.seg[:, 2] - x0, dom.seg[:, 3] - y0
     ones = np.ones_like(dx)
@@ -412,7 +413,7 @@ def _first_hits(dom: Domain, q: np.ndarray, phi: np.ndarray, *, brute: bool = Fa
 
 def _ray_line(q: np.ndarray, phi: np.ndarray, s: np.ndarray) -> np.ndarray:
     """Points where rays from ``q`` at angles ``phi`` meet the lines of segments ``s``."""
-    d = np.stack([np.cos(phi), np.sin(phi)], axis=1)
+    d = np.stack([_libm.cos(phi), _libm.sin(phi)], axis=1)
     a = s[:, :2] - q
     e = s[:, 2:] - s[:, :2]
     den = _cross(d, e)

@@ -54,6 +54,7 @@ import numpy as np
 import shapely
 from shapely import affinity
 
+from . import _libm
 from . import visindex as _visindex
 from ._common import polygonal
 from ._shapes import areal
@@ -320,9 +321,9 @@ class Sweeper:
         return out
 
     def _blind(self, p: np.ndarray, q: np.ndarray) -> np.ndarray:
-        base = np.arctan2(*(self.hull.mean(axis=0) - p).T[::-1])
+        base = _libm.atan2(*(self.hull.mean(axis=0) - p).T[::-1])
         rel = self.ring0[None, :, :] + (q - p)[:, None, :]
-        ang = (np.arctan2(rel[..., 1], rel[..., 0]) - base[:, None] + np.pi) % TAU - np.pi
+        ang = (_libm.atan2(rel[..., 1], rel[..., 0]) - base[:, None] + np.pi) % TAU - np.pi
         lo, hi = ang.min(axis=1), ang.max(axis=1)
         w_lo, w_hi, w_own = self._windows(p, base, np.stack([base + lo, hi - lo], axis=1))
         # a row without a window into K is blind whatever it would see of the target:
@@ -356,7 +357,7 @@ class Sweeper:
             xpt = kv[None, :, :] + lam[..., None] * (kv[nxt] - kv)[None, :, :]
         pts = np.concatenate([np.broadcast_to(kv, xpt.shape), xpt], axis=1)
         use = np.concatenate([keep, cross_e], axis=1)
-        rel = np.arctan2(pts[..., 1] - pp[:, None, 1], pts[..., 0] - pp[:, None, 0])
+        rel = _libm.atan2(pts[..., 1] - pp[:, None, 1], pts[..., 0] - pp[:, None, 0])
         rel = (rel - base[own][:, None] + np.pi) % TAU - np.pi
         amin = np.where(use, rel, np.inf).min(axis=1)
         amax = np.where(use, rel, -np.inf).max(axis=1)
@@ -376,7 +377,7 @@ class Sweeper:
         """Directions (relative to ``base``) in which, ignoring obstacles, the first
         point of A_q hit from p is wanted."""
         rel_pts = self.ring0[None, :, :] + (q - p)[:, None, :]
-        ang = np.arctan2(rel_pts[..., 1], rel_pts[..., 0])
+        ang = _libm.atan2(rel_pts[..., 1], rel_pts[..., 0])
         ang = (ang - base[:, None] + np.pi) % TAU - np.pi
         if self.strips is None:
             return ang.min(axis=1), ang.max(axis=1), np.arange(len(p))
@@ -414,8 +415,8 @@ class Sweeper:
                     continue
                 pl = a + lo[k, None] * e - (p - q)[j[k]]
                 ph = a + hi[k, None] * e - (p - q)[j[k]]
-                al = (np.arctan2(pl[:, 1], pl[:, 0]) - base[j[k]] + np.pi) % TAU - np.pi
-                ah = (np.arctan2(ph[:, 1], ph[:, 0]) - base[j[k]] + np.pi) % TAU - np.pi
+                al = (_libm.atan2(pl[:, 1], pl[:, 0]) - base[j[k]] + np.pi) % TAU - np.pi
+                ah = (_libm.atan2(ph[:, 1], ph[:, 0]) - base[j[k]] + np.pi) % TAU - np.pi
                 los.append(np.minimum(al, ah))
                 his.append(np.maximum(al, ah))
                 owns.append(j[k])
