@@ -439,7 +439,9 @@ def test_replay_tab_in_exported_file(browser, tmp_path):
 
 #: JS: the BokehJS view of the model named ``name`` (walks the views of every root)
 VIEW_OF = """(name) => { const m = Bokeh.documents[0].get_model_by_name(name); let found = null;
-const walk = (v) => { if (v.model === m) found = v; for (const c of (v.child_views || [])) walk(c) };
+const walk = (v) => {
+  if (v.model === m) found = v;
+  for (const c of (v.child_views || [])) walk(c) };
 for (const r of Bokeh.index.roots) walk(r); return found }"""
 
 
@@ -471,7 +473,8 @@ def test_served_app_needs_its_token(served):
 
 def _save_in_page(cdp: _CDP, path: str) -> str:
     """Type ``path`` into the save box, press "Save scene"; the file message shown."""
-    cdp.js(f"{_model('file_status')}.text = ''; {_model('save_path')}.value = {json.dumps(path)}; true")
+    cdp.js(f"{_model('file_status')}.text = ''; true")
+    cdp.js(f"{_model('save_path')}.value = {json.dumps(path)}; true")
     cdp.js(f"(({VIEW_OF})('save')).button_el.click(); true")
     return cdp.wait_js(
         f"(() => {{ const t = {_model('file_status')}.text; return t.length ? t : null }})()"
@@ -490,8 +493,12 @@ def test_served_app_saves_only_inside_its_root(served, tmp_path):
         msg = _save_in_page(cdp, outside)
         assert "save-refused" in msg and "outside the viewer" in msg, msg
         assert str(root.resolve()) in msg
-        # the message is on the page, in red, for the user to read
-        assert "Not saved" in cdp.js("document.body.innerText") or "Not saved" in msg
+        # the message is drawn on the page for the user to read
+        shown = cdp.wait_js(
+            f"(() => {{ const v = ({VIEW_OF})('file_status'); const t = (v.shadow_el || v.el)"
+            ".textContent; return t.includes('Not saved') ? t : null })()"
+        )
+        assert "outside the viewer's folder" in shown
     assert not (tmp_path / "outside.json").exists()
     assert sorted(p.name for p in tmp_path.iterdir()) == before  # no file appeared
     msg = _save_in_page(cdp, "notes.txt")

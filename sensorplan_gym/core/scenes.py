@@ -27,9 +27,7 @@ def bundled_scene_path(name: str) -> Path:
     return SCENE_DIR / f"{name}.json"
 
 
-def load_scene(
-    spec: str | PathLike[str] | Scene | Mapping, *, name: str | None = None
-) -> Scene:
+def load_scene(spec: str | PathLike[str] | Scene | Mapping, *, name: str | None = None) -> Scene:
     """A validated :class:`geometry.Scene` from
 
     * a bundled scene name (:data:`BUNDLED_SCENES`: ``lab``, ``edr``, ``corridor``,
