@@ -256,6 +256,28 @@ def test_cli_export(tmp_path, capsys):
     assert "unknown scene" in capsys.readouterr().err
 
 
+def test_cli_refuses_a_bad_token_or_root(tmp_path, capsys, monkeypatch):
+    """Checked before the server starts (these calls would otherwise serve forever)."""
+    pytest.importorskip("bokeh")
+    from agents.cli import main
+
+    monkeypatch.delenv("SENSORPLAN_VIEW_TOKEN", raising=False)
+    base = ["view", "lab", "--no-browser", "--port", "0"]
+    assert main([*base, "--token", "short"]) == 2
+    assert "at least 16 characters" in capsys.readouterr().err
+    assert main([*base, "--token", "a token with spaces 123"]) == 2
+    assert "at least 16 characters" in capsys.readouterr().err
+    monkeypatch.setenv("SENSORPLAN_VIEW_TOKEN", "weak")
+    assert main(base) == 2
+    assert "at least 16 characters" in capsys.readouterr().err
+    monkeypatch.delenv("SENSORPLAN_VIEW_TOKEN")
+    assert main([*base, "--root", str(tmp_path / "missing")]) == 2
+    assert "--root" in capsys.readouterr().err
+    # the export writes a file the user names on the command line: no token, no root
+    monkeypatch.setenv("SENSORPLAN_VIEW_TOKEN", "weak")
+    assert main(["view", "corridor", "--export", str(tmp_path / "v.html")]) == 0
+
+
 # ---- rollouts and their replay -----------------------------------------------------------
 
 

@@ -95,10 +95,12 @@ def main(argv: list[str] | None = None) -> int:
     from .layers import Settings
 
     try:
-        token = token_from(args.token)
-        root = Path.cwd() if args.root is None else Path(args.root)
-        if not args.export and not root.is_dir():
-            raise ValueError(f"--root {args.root}: not a directory")
+        token = root = None
+        if not args.export:  # the live viewer's access rules, checked before any work
+            token = token_from(args.token)
+            root = Path.cwd() if args.root is None else Path(args.root)
+            if not root.is_dir():
+                raise ValueError(f"--root {args.root}: not a directory")
         scene = load_scene(args.scene)
         over = {
             "model": args.model,
