@@ -560,7 +560,7 @@ class ViewerApp:
             self._file_message("load-error", f"<b>Not loaded</b>: {html.escape(str(e))}", False)
             return
         self.replace_scene(scene)
-        self._file_message("loaded", f"loaded scene {html.escape(scene.name)!s}", True)
+        self._file_message("loaded", f"loaded scene {html.escape(scene.name)}", True)
 
     def _on_revert(self) -> None:
         self.replace_scene(self.loaded)
