@@ -6,8 +6,9 @@
     sensorplan train --backend rllib [--address ADDR]   (watchers, RLlib; agents.rllib_train)
     sensorplan evaluate ... --backend ray [--address ADDR]   (episodes on Ray workers)
     sensorplan demo            (the paper's surveillance scenario end to end; see agents.demo)
-    sensorplan convert plan.geojson scene.json   (GeoJSON / WKT / scene JSON, by extension;
-                                                  see geometry.formats)
+    sensorplan convert plan.geojson scene.json   (GeoJSON / WKT / scene JSON, by extension,
+                                                  or a bundled name as input: convert lab
+                                                  lab.geojson; see geometry.formats)
     sensorplan view lab        (scenes and exact regions in the browser; --export view.html
                                 writes one self-contained file; see sensorplan_gym.viewer)
 """
@@ -209,9 +210,14 @@ def build_parser() -> argparse.ArgumentParser:
         "(scene JSON; on input a GeoJSON FeatureCollection is also recognised), .geojson "
         "(FeatureCollection with properties.role = bounds/obstacle/target/goal/failure/start) "
         "or .wkt ('role: WKT' lines).  The input is fully validated; obstacles with holes are "
-        "split into simple polygons.  See geometry.formats for the formats.",
+        "split into simple polygons.  The input may also be a bundled scene name "
+        "(sensorplan convert lab lab.geojson).  See geometry.formats for the formats.",
     )
-    c.add_argument("input", help="input file (.json, .geojson or .wkt)")
+    c.add_argument(
+        "input",
+        help="input: a file (.json, .geojson or .wkt) or a bundled scene name "
+        "(lab, edr, corridor, warehouse)",
+    )
     c.add_argument("output", help="output file (.json, .geojson or .wkt)")
     c.add_argument("--name", default=None, help="scene name (default: from the input)")
     return parser
@@ -289,10 +295,14 @@ def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     try:
         if args.command == "convert":
-            from geometry.formats import load_scene_file, save_scene_file
+            from geometry.formats import save_scene_file
+            from sensorplan_gym.core.scenes import load_scene
 
-            scene = load_scene_file(args.input, name=args.name)
-            save_scene_file(scene, args.output)
+            scene = load_scene(args.input, name=args.name)
+            try:
+                save_scene_file(scene, args.output)
+            except OSError as e:
+                raise ValueError(f"cannot write {args.output}: {e.strerror or e}") from None
             n_edges = len(scene.bounds) + sum(len(o) for o in scene.obstacles)
             print(
                 f"{args.input} -> {args.output}: scene {scene.name!r}, "

@@ -60,14 +60,18 @@ from .scene import Scene, SceneError
 __all__ = [
     "FormatError",
     "ROLES",
+    "SCENE_SUFFIXES",
     "load_scene_file",
     "save_scene_file",
+    "scene_from_data",
     "scene_from_geojson",
     "scene_from_obstacle_map",
     "scene_from_shapely",
+    "scene_from_text",
     "scene_from_wkt",
     "scene_to_geojson",
     "scene_to_shapely",
+    "scene_to_text",
     "scene_to_wkt",
     "simple_pieces",
 ]
@@ -578,34 +582,74 @@ def scene_from_obstacle_map(
 # ------------------------------------------------------------------------------------------
 
 
+#: File extensions of the scene formats (the format follows the extension).
+SCENE_SUFFIXES = (".json", ".geojson", ".wkt")
+
+
+def scene_from_data(data: Any, *, name: str | None = None) -> Scene:
+    """A scene from parsed JSON: a GeoJSON object (anything with a ``"type"`` member, which
+    must be a ``FeatureCollection``; see :func:`scene_from_geojson`) or a scene dict in the
+    pinned format (:meth:`geometry.Scene.from_dict`).  ``name`` overrides the scene's name."""
+    if isinstance(data, Mapping) and "type" in data:  # no scene has a "type" key
+        return scene_from_geojson(data, name=name)
+    scene = Scene.from_dict(data)
+    return scene.replace(name=name) if name is not None else scene
+
+
+def scene_from_text(
+    text: str,
+    ext: str | None = None,
+    *,
+    name: str | None = None,
+    default_name: str = "imported",
+) -> Scene:
+    """A scene from the text of a scene file in the format of extension ``ext``
+    (``.json``: scene JSON or GeoJSON, told apart by content; ``.geojson``; ``.wkt``).
+    ``ext=None`` tells the format by content: text starting with ``{`` is JSON, other text
+    is WKT.  ``default_name`` names a GeoJSON/WKT scene that names itself nowhere."""
+    if ext is None:
+        ext = ".json" if text.lstrip().startswith("{") else ".wkt"
+    ext = ext.lower()
+    if ext == ".wkt":
+        return scene_from_wkt(text, name=name, default_name=default_name)
+    if ext not in (".json", ".geojson"):
+        raise FormatError(f"unknown extension {ext!r} (use {', '.join(SCENE_SUFFIXES)})")
+    try:
+        data = json.loads(text)
+    except json.JSONDecodeError as e:
+        raise FormatError(f"invalid JSON: {e}") from None
+    if ext == ".geojson" or (isinstance(data, Mapping) and "type" in data):
+        if name is None and not (isinstance(data, Mapping) and isinstance(data.get("name"), str)):
+            name = default_name
+        return scene_from_geojson(data, name=name)
+    return scene_from_data(data, name=name)
+
+
+def scene_to_text(scene: Scene, ext: str) -> str:
+    """The text of ``scene`` in the file format of extension ``ext`` (see
+    :data:`SCENE_SUFFIXES`)."""
+    ext = ext.lower()
+    if ext == ".json":
+        return scene.to_json()
+    if ext == ".geojson":
+        return json.dumps(scene_to_geojson(scene), indent=1) + "\n"
+    if ext == ".wkt":
+        return scene_to_wkt(scene)
+    raise FormatError(f"unknown extension {ext!r} (use {', '.join(SCENE_SUFFIXES)})")
+
+
 def load_scene_file(path: str | PathLike[str], *, name: str | None = None) -> Scene:
-    """Load a scene from ``.json`` (scene JSON, or GeoJSON if it is a FeatureCollection),
-    ``.geojson`` or ``.wkt``.  Errors are prefixed with the file name."""
+    """Load a scene from ``.json`` (scene JSON, or GeoJSON if it has a ``"type"`` member),
+    ``.geojson`` or ``.wkt``.  Errors are :class:`FormatError` prefixed with the file name."""
     p = Path(path)
-    ext = p.suffix.lower()
     try:
         text = p.read_text(encoding="utf-8")
     except OSError as e:
         raise FormatError(f"{p}: cannot read: {e.strerror or e}") from None
+    except UnicodeDecodeError as e:
+        raise FormatError(f"{p}: not a text file (UTF-8): {e}") from None
     try:
-        if ext == ".wkt":
-            return scene_from_wkt(text, name=name, default_name=p.stem)
-        if ext not in (".json", ".geojson"):
-            raise FormatError(f"unknown extension {ext!r} (use .json, .geojson or .wkt)")
-        try:
-            data = json.loads(text)
-        except json.JSONDecodeError as e:
-            raise FormatError(f"invalid JSON: {e}") from None
-        if ext == ".geojson" or (
-            isinstance(data, Mapping) and data.get("type") == "FeatureCollection"
-        ):
-            if name is None and not (
-                isinstance(data, Mapping) and isinstance(data.get("name"), str)
-            ):
-                name = p.stem
-            return scene_from_geojson(data, name=name)
-        scene = Scene.from_dict(data)
-        return scene.replace(name=name) if name is not None else scene
+        return scene_from_text(text, p.suffix, name=name, default_name=p.stem)
     except SceneError as e:
         raise FormatError(f"{p}: {e}") from e
 
@@ -613,12 +657,8 @@ def load_scene_file(path: str | PathLike[str], *, name: str | None = None) -> Sc
 def save_scene_file(scene: Scene, path: str | PathLike[str]) -> None:
     """Write ``scene`` as scene JSON (``.json``), GeoJSON (``.geojson``) or WKT (``.wkt``)."""
     p = Path(path)
-    ext = p.suffix.lower()
-    if ext == ".json":
-        scene.save(p)
-    elif ext == ".geojson":
-        p.write_text(json.dumps(scene_to_geojson(scene), indent=1) + "\n", encoding="utf-8")
-    elif ext == ".wkt":
-        p.write_text(scene_to_wkt(scene), encoding="utf-8")
-    else:
-        raise FormatError(f"{p}: unknown extension {ext!r} (use .json, .geojson or .wkt)")
+    try:
+        text = scene_to_text(scene, p.suffix)
+    except FormatError as e:
+        raise FormatError(f"{p}: {e}") from None
+    p.write_text(text, encoding="utf-8")

@@ -419,7 +419,11 @@ class Scene:
         return copy.deepcopy(self._data)
 
     def save(self, path: str | PathLike[str]) -> None:
-        """Write the scene as JSON (``load(save(s)) == s``), indented, with every list of
+        """Write the scene as JSON (``load(save(s)) == s``) in the layout of :meth:`to_json`."""
+        Path(path).write_text(self.to_json(), encoding="utf-8")
+
+    def to_json(self) -> str:
+        """The scene as JSON text (what :meth:`save` writes), indented, with every list of
         numbers -- a vertex ``[x, y]``, a pose, a sensor range -- on one line, so a polygon
         reads one vertex per line.  Floats are written as ``repr`` (round trips are exact)."""
 
@@ -434,7 +438,7 @@ class Scene:
                 return "[\n" + ",\n".join(inner + dump(x, inner) for x in v) + "\n" + pad + "]"
             return json.dumps(v)
 
-        Path(path).write_text(dump(self._data, "") + "\n", encoding="utf-8")
+        return dump(self._data, "") + "\n"
 
     def replace(self, **changes: Any) -> Scene:
         """A new validated scene with some JSON keys replaced (``None`` removes sensor/start)."""

@@ -274,3 +274,93 @@ def test_convert_cli(tmp_path, capsys):
     assert "bad.geojson" in err and "features[1] (role 'obstacle')" in err
     assert cli_main(["convert", str(src), str(tmp_path / "x.shp")]) == 2
     assert "unknown extension '.shp'" in capsys.readouterr().err
+
+
+# ---- one scene loader everywhere: load_scene dispatches on name, extension and content ----
+
+
+@pytest.fixture(scope="module")
+def wh_files(tmp_path_factory):
+    """The warehouse scene as .geojson, GeoJSON in a .json, .wkt and scene JSON."""
+    d = tmp_path_factory.mktemp("wh")
+    s = load_scene("warehouse")
+    save_scene_file(s, d / "plan.geojson")
+    (d / "plan_geo.json").write_text(json.dumps(scene_to_geojson(s)))
+    save_scene_file(s, d / "plan.wkt")
+    s.save(d / "plan.json")
+    return s, d
+
+
+def test_load_scene_every_format(wh_files):
+    s, d = wh_files
+    for f in ("plan.geojson", "plan_geo.json", "plan.json"):
+        _same(s, load_scene(d / f))  # a Path
+        _same(s, load_scene(str(d / f)))  # a str
+    w = load_scene(d / "plan.wkt")
+    assert w.name == s.name and len(w.obstacles) == len(s.obstacles)
+    _same(s, load_scene(scene_to_geojson(s)))  # a GeoJSON dict
+    _same(s, load_scene(s.to_dict()))  # a scene dict
+    assert load_scene(s) is s
+    # name= renames whatever the source
+    for spec in ("warehouse", d / "plan.geojson", d / "plan.wkt", s.to_dict(), s):
+        assert load_scene(spec, name="renamed").name == "renamed"
+    # a GeoJSON without a name takes the file's stem, as load_scene_file does
+    g = scene_to_geojson(s)
+    g.pop("name", None)
+    (d / "nameless.geojson").write_text(json.dumps(g))
+    assert load_scene(d / "nameless.geojson").name == "nameless"
+
+
+def test_load_scene_errors(tmp_path):
+    with pytest.raises(FileNotFoundError, match="scene file not found"):
+        load_scene(tmp_path / "missing.geojson")
+    with pytest.raises(ValueError, match="unknown scene 'nosuch'.*lab.*geojson"):
+        load_scene("nosuch")
+    (tmp_path / "plan.shp").write_text("x")
+    with pytest.raises(FormatError, match=r"plan\.shp.*unknown extension '\.shp'"):
+        load_scene(tmp_path / "plan.shp")
+    # a GeoJSON object that is not a FeatureCollection: said so, not "unknown key 'type'"
+    (tmp_path / "f.json").write_text('{"type": "Feature", "geometry": null}')
+    with pytest.raises(FormatError, match="f.json: expected a GeoJSON FeatureCollection"):
+        load_scene(tmp_path / "f.json")
+    with pytest.raises(FormatError, match="expected a GeoJSON FeatureCollection, got 'Polygon'"):
+        load_scene({"type": "Polygon", "coordinates": []})
+    (tmp_path / "bin.json").write_bytes(b"\xff\xfe\x00")
+    with pytest.raises(FormatError, match="bin.json: not a text file"):
+        load_scene(tmp_path / "bin.json")
+
+
+def test_geojson_scene_in_envs(wh_files):
+    import gymnasium as gym
+
+    s, d = wh_files
+    env = gym.make("sensorplan/Placement-v0", scene=str(d / "plan.geojson"))
+    env.reset(seed=0)
+    _same(s, env.unwrapped.batch.source.world.scene)  # the GeoJSON file's scene, exactly
+    env.close()
+
+
+@pytest.mark.parametrize("name", sensorplan_gym.BUNDLED_SCENES)
+def test_convert_bundled_names(name, tmp_path, capsys):
+    out = tmp_path / f"{name}.geojson"
+    assert cli_main(["convert", name, str(out)]) == 0
+    assert f"scene {name!r}" in capsys.readouterr().out
+    _same(load_scene(name), load_scene(out))
+
+
+def test_convert_cli_errors(tmp_path, capsys):
+    assert cli_main(["convert", "nosuch", str(tmp_path / "x.json")]) == 2
+    assert "unknown scene 'nosuch'" in capsys.readouterr().err
+    assert cli_main(["convert", "lab", str(tmp_path / "no" / "dir" / "x.json")]) == 2
+    err = capsys.readouterr().err
+    assert "cannot write" in err and "Traceback" not in err
+    assert not (tmp_path / "no").exists()
+
+
+def test_view_accepts_geojson(wh_files, tmp_path, capsys):
+    pytest.importorskip("bokeh")
+    s, d = wh_files
+    for f in ("plan.geojson", "plan_geo.json", "plan.wkt"):
+        out = tmp_path / f"{f}.html"
+        assert cli_main(["view", str(d / f), "--export", str(out)]) == 0, capsys.readouterr()
+        assert "layer:recognizable" in out.read_text(encoding="utf-8")

@@ -114,11 +114,12 @@ def test_probe_fov_uses_the_env_aim_check():
 
 
 @pytest.fixture
-def app(lab):
+def app(lab, tmp_path):
     pytest.importorskip("bokeh")
     from sensorplan_gym.viewer.app import ViewerApp
 
-    return ViewerApp(lab)
+    (tmp_path / "root").mkdir()
+    return ViewerApp(lab, root=tmp_path / "root")
 
 
 def _obstacles(app):
@@ -189,20 +190,58 @@ def test_app_probe_text(app):
 
 
 def test_app_save_and_load(app, lab, tmp_path):
-    out = tmp_path / "edited.json"
+    root = tmp_path / "root"
+    assert app.root_dir == root.resolve()
     xs, ys = _obstacles(app)
     app.sf.sources["obstacles"].data = {"xs": xs[:-1], "ys": ys[:-1]}
-    app.w_save_path.value = str(out)
+    app.w_save_path.value = "edited.json"  # relative to the root, not to the cwd
     app._on_save()
+    out = root / "edited.json"
+    assert "id='saved'" in app.file_status.text and str(out.resolve()) in app.file_status.text
     saved = load_scene(out)
     assert len(saved.obstacles) == len(lab.obstacles) - 1
     assert np.allclose(saved.target, lab.target)
+    # GeoJSON and WKT by the name's extension
+    assert app.save("edited.geojson") == (root / "edited.geojson").resolve()
+    assert load_scene(root / "edited.geojson") == saved
+    assert app.save("sub/x.wkt") is None  # no such folder: refused, said so
+    assert "No such file or directory" in app.file_status.text
     # load it back through the file-input widget (base64 of the file's bytes)
     other = load_scene("corridor")
     app._on_load("value", None, base64.b64encode(json.dumps(other.to_dict()).encode()).decode())
     assert app.scene == other and app.error is None
+    assert "id='loaded'" in app.file_status.text
     app._on_load("value", None, base64.b64encode(b"{not json").decode())
-    assert "not loaded" in app.status.text
+    assert "Not loaded" in app.file_status.text and "invalid JSON" in app.file_status.text
+    # GeoJSON and WKT uploads (told apart by content: the browser sends no trustworthy name)
+    from geometry.formats import scene_to_geojson, scene_to_wkt
+
+    edr = load_scene("edr")
+    app._on_load("value", None, base64.b64encode(json.dumps(scene_to_geojson(edr)).encode()))
+    assert app.scene == edr, app.file_status.text
+    app._on_load("value", None, base64.b64encode(scene_to_wkt(other).encode()).decode())
+    assert app.scene == other, app.file_status.text
+    # a GeoJSON Feature (not a collection) says so, instead of "unknown key 'type'"
+    app._on_load("value", None, base64.b64encode(b'{"type": "Feature"}').decode())
+    assert "FeatureCollection" in app.file_status.text
+
+
+@pytest.mark.parametrize(
+    "name",
+    ["../outside.json", "{parent}/outside.json", "link/outside.json", "sneaky.json",
+     "~/outside.json", "notes.txt", "", "a/../../outside.json"],
+)  # fmt: skip
+def test_app_save_outside_root_refused(app, tmp_path, name):
+    root = tmp_path / "root"
+    (root / "a").mkdir()
+    (root / "link").symlink_to(tmp_path, target_is_directory=True)
+    (root / "sneaky.json").symlink_to(tmp_path / "outside.json")
+    before = sorted(p.name for p in tmp_path.iterdir())
+    assert app.save(name.format(parent=tmp_path)) is None
+    assert "id='save-refused'" in app.file_status.text and "Not saved" in app.file_status.text
+    assert sorted(p.name for p in tmp_path.iterdir()) == before  # nothing written outside
+    assert not (tmp_path / "outside.json").exists()
+    assert sorted(p.name for p in root.iterdir()) == ["a", "link", "sneaky.json"]
 
 
 def test_cli_export(tmp_path, capsys):
@@ -215,6 +254,28 @@ def test_cli_export(tmp_path, capsys):
     assert "layer:recognizable" in text and "motion=stationary" in text
     assert main(["view", "nosuch", "--export", str(out)]) == 2
     assert "unknown scene" in capsys.readouterr().err
+
+
+def test_cli_refuses_a_bad_token_or_root(tmp_path, capsys, monkeypatch):
+    """Checked before the server starts (these calls would otherwise serve forever)."""
+    pytest.importorskip("bokeh")
+    from agents.cli import main
+
+    monkeypatch.delenv("SENSORPLAN_VIEW_TOKEN", raising=False)
+    base = ["view", "lab", "--no-browser", "--port", "0"]
+    assert main([*base, "--token", "short"]) == 2
+    assert "at least 16 characters" in capsys.readouterr().err
+    assert main([*base, "--token", "a token with spaces 123"]) == 2
+    assert "at least 16 characters" in capsys.readouterr().err
+    monkeypatch.setenv("SENSORPLAN_VIEW_TOKEN", "weak")
+    assert main(base) == 2
+    assert "at least 16 characters" in capsys.readouterr().err
+    monkeypatch.delenv("SENSORPLAN_VIEW_TOKEN")
+    assert main([*base, "--root", str(tmp_path / "missing")]) == 2
+    assert "--root" in capsys.readouterr().err
+    # the export writes a file the user names on the command line: no token, no root
+    monkeypatch.setenv("SENSORPLAN_VIEW_TOKEN", "weak")
+    assert main(["view", "corridor", "--export", str(tmp_path / "v.html")]) == 0
 
 
 # ---- rollouts and their replay -----------------------------------------------------------

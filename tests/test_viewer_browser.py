@@ -5,7 +5,10 @@
 * the live app is served by ``sensorplan view`` in a subprocess on a free port and
   driven over the DevTools protocol (tornado's websocket client, which Bokeh brings):
   the page renders, an obstacle edited in the browser changes the region computed on
-  the server, an invalid edit shows the SceneError message.
+  the server, an invalid edit shows the SceneError message;
+* access: a page opened without the printed token (or with a wrong one) gets the 403
+  page and no app, with the token it gets the app; a save outside the viewer's root
+  folder is refused in the page and no file appears, a save inside it is written.
 
 Skipped when chromium or Bokeh is missing (``.ci/run`` installs both).
 """
@@ -250,17 +253,29 @@ def _stop(proc: subprocess.Popen) -> None:
 
 @pytest.fixture
 def served(tmp_path, browser):
-    """(app url, devtools client) with ``sensorplan view lab`` served on a free port."""
+    """(app url with its token, devtools client) with ``sensorplan view lab --root
+    <tmp>/root`` served on a free port (started in ``tmp_path``); the URL is the one the
+    command printed."""
     app_port = _free_port()
     env = dict(os.environ, PYTHONPATH=str(REPO), MPLBACKEND="Agg")
+    env.pop("SENSORPLAN_VIEW_TOKEN", None)
+    (tmp_path / "root").mkdir()
     app = subprocess.Popen(
         [sys.executable, "-m", "sensorplan_gym.viewer.cli", "lab", "--port", str(app_port),
-         "--no-browser"],
+         "--no-browser", "--root", "root"],
         cwd=tmp_path, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
     )  # fmt: skip
     try:
+        url = None
+        for line in app.stdout:  # the command prints its URL once it listens
+            m = re.search(r"at (http://localhost:\d+/\?token=[0-9a-f]{48}) ", line)
+            if m:
+                url = m.group(1).replace("localhost", "127.0.0.1")
+                break
+        assert url is not None, f"no URL printed; exit code {app.poll()}"
+        assert str((tmp_path / "root").resolve()) in line  # says where the page saves
         _wait_port(app_port, app)
-        yield f"http://127.0.0.1:{app_port}/", browser
+        yield url, browser
     finally:
         _stop(app)
 
@@ -418,3 +433,84 @@ def test_replay_tab_in_exported_file(browser, tmp_path):
     assert x == pytest.approx(ro["steps"][k]["pose"][0])
     n_beams = cdp.js(f"{_model('src:replay_beams')}.data.x1.length")
     assert n_beams == len(ro["steps"][k]["beams"][0]) > 0
+
+
+# ---- access: the token and the confined saves ---------------------------------------------
+
+#: JS: the BokehJS view of the model named ``name`` (walks the views of every root)
+VIEW_OF = """(name) => { const m = Bokeh.documents[0].get_model_by_name(name); let found = null;
+const walk = (v) => {
+  if (v.model === m) found = v;
+  for (const c of (v.child_views || [])) walk(c) };
+for (const r of Bokeh.index.roots) walk(r); return found }"""
+
+
+def _page_state(cdp: _CDP) -> dict:
+    """Wait for the page to load; what it shows: BokehJS documents, the 403 marker."""
+    cdp.wait_js("document.readyState === 'complete'")
+    time.sleep(1.0)  # a served app would have opened its websocket and built its document
+    return cdp.js(
+        "({bokeh: window.Bokeh !== undefined ? Bokeh.documents.length : -1, "
+        "forbidden: !!document.getElementById('token-required'), "
+        "text: document.body ? document.body.innerText : ''})"
+    )
+
+
+def test_served_app_needs_its_token(served):
+    url, cdp = served
+    base, token = url.split("?token=")
+    cdp.call("Page.enable")
+    wrong = token[:-1] + ("1" if token[-1] == "0" else "0")
+    for bad in (base, f"{base}?token={wrong}", f"{base}?token=", f"{base}?bokeh-session-id=x"):
+        cdp.call("Page.navigate", url=bad)
+        st = _page_state(cdp)
+        assert st["forbidden"] and st["bokeh"] == -1, (bad, st)  # no BokehJS, no session
+        assert "needs its access token" in st["text"] and "?token=" in st["text"]
+    cdp.call("Page.navigate", url=url)
+    cdp.wait_js(f"window.Bokeh !== undefined && Bokeh.documents.length > 0 && !!{_model('tabs')}")
+    cdp.wait_js(f"{_model('status')}.text.includes('Exact')")  # the server computed the regions
+
+
+def _save_in_page(cdp: _CDP, path: str) -> str:
+    """Type ``path`` into the save box, press "Save scene"; the file message shown."""
+    cdp.js(f"{_model('file_status')}.text = ''; true")
+    cdp.js(f"{_model('save_path')}.value = {json.dumps(path)}; true")
+    cdp.js(f"(({VIEW_OF})('save')).button_el.click(); true")
+    return cdp.wait_js(
+        f"(() => {{ const t = {_model('file_status')}.text; return t.length ? t : null }})()"
+    )
+
+
+def test_served_app_saves_only_inside_its_root(served, tmp_path):
+    url, cdp = served
+    root = tmp_path / "root"
+    (root / "link").symlink_to(tmp_path, target_is_directory=True)
+    cdp.call("Page.enable")
+    cdp.call("Page.navigate", url=url)
+    cdp.wait_js(f"window.Bokeh !== undefined && Bokeh.documents.length > 0 && !!{_model('save')}")
+    before = sorted(p.name for p in tmp_path.iterdir())
+    for outside in ("../outside.json", str(tmp_path / "outside.json"), "link/outside.json"):
+        msg = _save_in_page(cdp, outside)
+        assert "save-refused" in msg and "outside the viewer" in msg, msg
+        assert str(root.resolve()) in msg
+        # the message is drawn on the page for the user to read
+        shown = cdp.wait_js(
+            f"(() => {{ const v = ({VIEW_OF})('file_status'); const t = (v.shadow_el || v.el)"
+            ".textContent; return t.includes('Not saved') ? t : null })()"
+        )
+        assert "outside the viewer's folder" in shown
+    assert not (tmp_path / "outside.json").exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == before  # no file appeared
+    msg = _save_in_page(cdp, "notes.txt")
+    assert "save-refused" in msg and "scene files only" in msg
+    assert sorted(p.name for p in root.iterdir()) == ["link"]
+    # inside the root: written, relative to the root
+    msg = _save_in_page(cdp, "edited.geojson")
+    assert "id='saved'" in msg, msg
+    from sensorplan_gym.core.world import load_scene
+
+    saved, lab = load_scene(root / "edited.geojson"), load_scene("lab")
+    assert saved.name == "lab" and len(saved.obstacles) == len(lab.obstacles)
+    for got, want in zip(saved.obstacles, lab.obstacles, strict=True):
+        assert np.allclose(got, want, atol=1e-9)
+    assert np.allclose(saved.target, lab.target, atol=1e-9)

@@ -1,12 +1,22 @@
-"""Scene loading: the bundled scenes by name, scene JSON files, dicts and Scene objects."""
+"""Scene loading: the one function every scene argument goes through.
+
+:func:`load_scene` takes a bundled scene name, a path to a scene file in any of the
+formats of :mod:`geometry.formats` (scene JSON, GeoJSON, WKT; by extension, and for
+``.json`` by content), a parsed dict (scene JSON or a GeoJSON FeatureCollection) or a
+:class:`geometry.Scene`.  The envs' ``scene=``, ``sensorplan view``, ``sensorplan
+convert`` and the tools that take scene names all call it.
+"""
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+from os import PathLike
 from pathlib import Path
 
 from geometry import Scene
+from geometry.formats import SCENE_SUFFIXES, load_scene_file, scene_from_data
 
-__all__ = ["BUNDLED_SCENES", "SCENE_DIR", "bundled_scene_path", "load_scene"]
+__all__ = ["BUNDLED_SCENES", "SCENE_DIR", "SCENE_SUFFIXES", "bundled_scene_path", "load_scene"]
 
 SCENE_DIR = Path(__file__).resolve().parent.parent / "scenes"
 BUNDLED_SCENES = tuple(sorted(p.stem for p in SCENE_DIR.glob("*.json")))
@@ -17,24 +27,39 @@ def bundled_scene_path(name: str) -> Path:
     return SCENE_DIR / f"{name}.json"
 
 
-def load_scene(spec: str | Path | Scene | dict) -> Scene:
-    """A validated :class:`geometry.Scene` from a bundled scene name, a path to a scene JSON
-    file, a scene dict or a Scene (returned as is).  Raises ``FileNotFoundError`` for a
-    missing file, ``ValueError`` for an unknown name and :class:`geometry.SceneError` for
-    an invalid scene."""
+def load_scene(spec: str | PathLike[str] | Scene | Mapping, *, name: str | None = None) -> Scene:
+    """A validated :class:`geometry.Scene` from
+
+    * a bundled scene name (:data:`BUNDLED_SCENES`: ``lab``, ``edr``, ``corridor``,
+      ``warehouse``);
+    * a path to a scene file: ``.json`` (scene JSON, or GeoJSON when the object has a
+      ``"type"`` member), ``.geojson`` or ``.wkt`` (see :mod:`geometry.formats`);
+    * a dict: scene JSON, or a GeoJSON FeatureCollection (it has a ``"type"`` member);
+    * a Scene (returned as is, unless renamed).
+
+    ``name`` overrides the scene's name.  A bundled name wins over a file of that name in
+    the current folder (write ``./lab`` for the file).  Raises ``FileNotFoundError`` for a
+    missing file, ``ValueError`` for an unknown name and :class:`geometry.SceneError` (a
+    ``ValueError``; :class:`geometry.formats.FormatError` for files) for an invalid scene,
+    naming the file and the offending feature or key.
+    """
     if isinstance(spec, Scene):
-        return spec
-    if isinstance(spec, dict):
-        return Scene.from_dict(spec)
-    s = str(spec)
-    if s in BUNDLED_SCENES:
-        return Scene.load(bundled_scene_path(s))
-    p = Path(s)
-    if p.suffix == ".json" or p.exists():
-        if not p.exists():
-            raise FileNotFoundError(f"scene file not found: {p}")
-        return Scene.load(p)
-    raise ValueError(
-        f"unknown scene {s!r}: use a bundled name ({', '.join(BUNDLED_SCENES)}), "
-        "a path to a scene JSON file, or 'random'"
-    )
+        scene = spec
+    elif isinstance(spec, Mapping):
+        return scene_from_data(spec, name=name)
+    else:
+        s = str(spec)
+        if s in BUNDLED_SCENES:
+            scene = Scene.load(bundled_scene_path(s))
+        else:
+            p = Path(s)
+            if p.suffix.lower() not in SCENE_SUFFIXES and not p.exists():
+                raise ValueError(
+                    f"unknown scene {s!r}: use a bundled name ({', '.join(BUNDLED_SCENES)}) "
+                    f"or a path to a scene file ({', '.join(SCENE_SUFFIXES)}); the envs also "
+                    "take 'random'"
+                )
+            if not p.exists():
+                raise FileNotFoundError(f"scene file not found: {p}")
+            return load_scene_file(p, name=name)
+    return scene if name is None else scene.replace(name=name)

@@ -10,8 +10,10 @@ Common keyword arguments (``gym.make(id, **kwargs)`` and ``gym.make_vec(id, **kw
 ----------------------------------------------------------------------------------------
 scene : str | path | dict | geometry.Scene, default ``"lab"``
     A bundled scene name (``lab``, ``edr``, ``corridor``, ``warehouse``), a path to a scene
-    JSON file in the pinned format, or ``"random"``: at every reset a scene drawn (with the
-    env's ``np_random``) from a seeded pool of procedural scenes
+    file (scene JSON in the pinned format, GeoJSON or WKT: see
+    :func:`sensorplan_gym.core.scenes.load_scene`), a dict, a ``geometry.Scene``, or
+    ``"random"``: at every reset a scene drawn (with the env's ``np_random``) from a
+    seeded pool of procedural scenes
     (:class:`~sensorplan_gym.core.pool.ScenePool`; scenes whose region is empty, unreachable
     from the start, or that contain the start are re-drawn when the pool is built).
 scene_pool_size : int, default 64 -- scenes in the ``"random"`` pool.

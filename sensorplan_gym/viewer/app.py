@@ -17,23 +17,38 @@ What it does
   exact visibility polygon, whether it sees A in G and in H (the chosen model),
   whether it is in the recognizable region and whether the best aim passes the
   field-of-view check; a click pins the placement;
-* save the edited scene as JSON on this machine, or load a scene JSON file;
+* save the edited scene on this machine (scene JSON, ``.geojson`` or ``.wkt``, by the
+  name's extension), or load a scene file (scene JSON, GeoJSON or WKT) from the browser;
 * a second tab replays a rollout saved by :mod:`.replay` when one is given.
+
+Access and files
+----------------
+* The server listens on 127.0.0.1 only and serves only requests carrying its token:
+  ``sensorplan view`` prints ``http://localhost:PORT/?token=...`` (a random token per
+  launch; ``--token`` or ``$SENSORPLAN_VIEW_TOKEN`` give one).  A page opened without it
+  gets a 403 page and no session (see :mod:`.auth`).
+* Saves are confined to the viewer's *root* folder: the folder it was started in, or
+  ``--root DIR``.  A path outside it (after resolving symlinks and ``..``), or one not
+  ending in ``.json``/``.geojson``/``.wkt``, is refused with a message in the page and
+  nothing is written (see :mod:`.files`).  Loading uploads the content of a file the
+  browser's user picks; the server opens no path for it.
 """
 
 from __future__ import annotations
 
 import base64
 import html
-import json
 import math
 import time
+from os import PathLike
 from pathlib import Path
 from typing import Any
 
 from geometry import Scene, SceneError
+from geometry.formats import scene_from_text
 
 from .figure import build_figure, layer_data, scene_data
+from .files import save_scene_confined
 from .layers import (
     LAYER_TITLES,
     LAYERS,
@@ -110,8 +125,14 @@ class ViewerApp:
         save_path: str | None = None,
         rollout: str | None = None,
         unit: str = "m",
+        root: str | PathLike[str] | None = None,
     ) -> None:
+        """``root``: the folder saves are confined to (default: the current directory);
+        ``save_path``: the save box's initial value, relative to ``root``."""
         self.unit = unit
+        self.root_dir = Path.cwd().resolve() if root is None else Path(root).resolve()
+        if not self.root_dir.is_dir():
+            raise NotADirectoryError(f"the viewer's root folder {self.root_dir} is not a directory")
         self.scene = scene
         self.settings = Settings.from_scene(scene) if settings is None else settings
         self.visible = tuple(visible)
@@ -268,15 +289,20 @@ class ViewerApp:
             name="probe",
         )
         self.w_save_path = TextInput(
-            title="save scene JSON to (on this machine)",
+            title=f"save scene to (.json, .geojson or .wkt, inside {self.root_dir})",
             value=self.save_path,
             name="save_path",
             width=330,
         )
         self.w_save = Button(label="Save scene", name="save", width=120)
         self.w_save.on_click(self._on_save)
-        self.w_load = FileInput(accept=".json", name="load", title="load a scene JSON")
+        self.w_load = FileInput(
+            accept=".json,.geojson,.wkt",
+            name="load",
+            title="load a scene (scene JSON, GeoJSON or WKT)",
+        )
         self.w_load.on_change("value", self._on_load)
+        self.file_status = Div(text="", width=330, name="file_status")
         self.w_reset = Button(label="Revert to the last loaded scene", name="revert", width=220)
         self.w_reset.on_click(self._on_revert)
         self.loaded = self.scene
@@ -314,6 +340,7 @@ class ViewerApp:
             help_div,
             self.w_save_path,
             row(self.w_save, self.w_reset),
+            self.file_status,
             self.w_load,
             width=350,
         )
@@ -497,26 +524,43 @@ class ViewerApp:
         self.pinned = not self.pinned
         self.probe_at(event.x, event.y)
 
-    def _on_save(self) -> None:
-        path = Path(self.w_save_path.value).expanduser()
+    def _file_message(self, kind: str, text: str, ok: bool) -> None:
+        colour = "#137333" if ok else "#b00020"
+        self.file_status.text = (
+            f"<div id='{kind}' style='color:{colour};border:1px solid {colour};padding:4px'>"
+            f"{text}</div>"
+        )
+
+    def save(self, path: str) -> Path | None:
+        """Save the scene as drawn to ``path`` (relative to the root, confined to it; see
+        :func:`.files.save_scene_confined`); returns the path written, or ``None`` with the
+        reason shown in the page."""
         try:
             scene = scene_from_sources(self.scene, self._data(), self.target_at)
-            scene.save(path)
-        except (SceneError, OSError) as e:
-            self.error = f"not saved: {e}"
-            self._show_status()
-            return
-        self.status.text = f"<div id='saved'>saved {html.escape(str(path.resolve()))}</div>"
+            out = save_scene_confined(scene, path, self.root_dir)
+        except OSError as e:
+            where = f" ({e.filename})" if getattr(e, "filename", None) else ""
+            msg = f"{e.strerror or e}{where}"
+            self._file_message("save-refused", f"<b>Not saved</b>: {html.escape(msg)}", False)
+            return None
+        except ValueError as e:  # SceneError, OutsideRootError, a bad name
+            self._file_message("save-refused", f"<b>Not saved</b>: {html.escape(str(e))}", False)
+            return None
+        self._file_message("saved", f"saved {html.escape(str(out))}", True)
+        return out
+
+    def _on_save(self) -> None:
+        self.save(self.w_save_path.value)
 
     def _on_load(self, attr, old, new) -> None:
         try:
-            d = json.loads(base64.b64decode(new).decode("utf-8"))
-            scene = Scene.from_dict(d)
-        except (ValueError, SceneError, UnicodeDecodeError) as e:
-            self.error = f"not loaded: {e}"
-            self._show_status()
+            text = base64.b64decode(new).decode("utf-8")
+            scene = scene_from_text(text, None, default_name="uploaded")
+        except (ValueError, UnicodeDecodeError) as e:  # SceneError, FormatError, base64
+            self._file_message("load-error", f"<b>Not loaded</b>: {html.escape(str(e))}", False)
             return
         self.replace_scene(scene)
+        self._file_message("loaded", f"loaded scene {html.escape(scene.name)}", True)
 
     def _on_revert(self) -> None:
         self.replace_scene(self.loaded)
@@ -557,33 +601,54 @@ def serve(
     rollout: str | None = None,
     unit: str = "m",
     ready: Any = None,
+    root: str | PathLike[str] | None = None,
+    token: str | None = None,
 ) -> None:
-    """Serve the viewer on ``http://localhost:<port>/`` until interrupted (Ctrl-C).
+    """Serve the viewer on ``http://localhost:<port>/?token=<token>`` until interrupted.
 
-    ``port=0`` picks a free port.  ``ready(url)`` is called once the server listens.
+    ``port=0`` picks a free port.  ``token``: the access token every page request must
+    carry (default: a random one, see :mod:`.auth`); ``root``: the folder the page's
+    saves are confined to (default: the current directory, see :mod:`.files`).
+    ``ready(url)`` is called with the full URL (token included) once the server listens.
     """
     from bokeh.application import Application
     from bokeh.application.handlers.function import FunctionHandler
     from bokeh.server.server import Server
+    from bokeh.util.token import generate_secret_key
+
+    from .auth import TokenAuth, new_token
 
     port = port or free_port()
+    token = new_token() if token is None else token
+    root_dir = Path.cwd().resolve() if root is None else Path(root).resolve()
+    if not root_dir.is_dir():
+        raise NotADirectoryError(f"--root {root_dir}: not a directory")
+    secret_key = generate_secret_key()  # per launch: signs the session ids and JWTs
 
     def handler(doc):
-        make_document(doc, scene, settings, rollout=rollout, unit=unit)
+        make_document(doc, scene, settings, rollout=rollout, unit=unit, root=root_dir)
 
     server = Server(
         {"/": Application(FunctionHandler(handler))},
         port=port,
         address="127.0.0.1",
         allow_websocket_origin=[f"localhost:{port}", f"127.0.0.1:{port}"],
+        auth_provider=TokenAuth(token, secret_key),
+        sign_sessions=True,
+        secret_key=secret_key,
+        generate_session_ids=True,
     )
     server.start()
-    url = f"http://localhost:{port}/"
-    print(f"sensorplan view: serving {scene.name!r} at {url} (Ctrl-C to stop)", flush=True)
+    url = f"http://localhost:{port}/?token={token}"
+    print(
+        f"sensorplan view: serving {scene.name!r} at {url} (Ctrl-C to stop); "
+        f"the page saves inside {root_dir}",
+        flush=True,
+    )
     if ready is not None:
         ready(url)
     if show:
-        server.io_loop.add_callback(server.show, "/")
+        server.io_loop.add_callback(server.show, f"/?token={token}")
     try:
         server.io_loop.start()
     except KeyboardInterrupt:  # pragma: no cover - interactive

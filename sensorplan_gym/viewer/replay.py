@@ -369,7 +369,11 @@ def main(argv: list[str] | None = None) -> int:
     )
     ap.add_argument("--env", default="sensorplan/Recognize-v0")
     ap.add_argument("--policy", choices=("oracle", "random"), default="oracle")
-    ap.add_argument("--scene", default="lab")
+    ap.add_argument(
+        "--scene",
+        default="lab",
+        help="bundled scene name or scene file: scene JSON, GeoJSON or WKT (default: lab)",
+    )
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--max-steps", type=int, default=None)
     ap.add_argument("--out", default="rollout.json")
