@@ -6,7 +6,7 @@ coordinates) and every finding of :func:`geometry.fuzz.check_scene` fails the te
 crashes, invalid output, output outside the free space, violated inclusions, unsafe
 members of complete regions, translation variance, queries over 10 s.  The seeds that
 exposed bugs during development are pinned.  Long version: ``python -m geometry.fuzz
---n 10000 [--swept]`` or ``SENSORPLAN_SLOW=1 pytest -m slow tests/test_fuzz.py``.
+--n 10000 [--swept]`` or ``SENSORPLAN_SLOW=1 pytest -m slow tests/geometry/test_fuzz.py``.
 """
 
 from __future__ import annotations

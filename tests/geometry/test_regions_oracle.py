@@ -480,7 +480,8 @@ def test_regions_agree_with_oracle_many_scenes():
     _check_eps(seeds, SLOW_POINTS, 3 * N_EPS_POINTS)
 
 
-if __name__ == "__main__":  # agreement report: python -m tests.test_regions_oracle [--slow]
+# agreement report: python -m tests.geometry.test_regions_oracle [--slow]
+if __name__ == "__main__":
     import sys
     import time
 

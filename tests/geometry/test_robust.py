@@ -1,6 +1,6 @@
 """Robustness of the region functions (issue 10): local frames (translation and scale
 invariance), degenerate contacts (an obstacle flush on the target's hull or on a wall),
-input validation.  The fuzz suite is ``tests/test_fuzz.py``."""
+input validation.  The fuzz suite is ``tests/geometry/test_fuzz.py``."""
 
 from __future__ import annotations
 

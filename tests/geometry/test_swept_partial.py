@@ -319,7 +319,8 @@ def test_swept_bad_input_is_named():
     assert star_center(hooks) is None
 
 
-if __name__ == "__main__":  # python -m tests.test_swept_partial --slow [N]: the README's numbers
+# python -m tests.geometry.test_swept_partial --slow [N]: the README's numbers
+if __name__ == "__main__":
     import sys
 
     n = int(sys.argv[2]) if len(sys.argv) > 2 else 40
