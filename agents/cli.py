@@ -3,7 +3,8 @@
     sensorplan train --env sensorplan/Navigate-v0 --algo ppo --timesteps 150000 --seed 0 --n-envs 2
     sensorplan evaluate --env sensorplan/Navigate-v0 --policies oracle random \\
         agents/pretrained/ppo_navigate_lab.zip --episodes 200 --seed 0
-    sensorplan train --backend rllib [--address ADDR]   (watchers, RLlib; agents.rllib_train)
+    sensorplan train --backend rllib [--address ADDR]
+        (watchers, RLlib; agents.learning.rllib_train)
     sensorplan evaluate ... --backend ray [--address ADDR]   (episodes on Ray workers)
     sensorplan demo            (the paper's surveillance scenario end to end; see agents.demo)
     sensorplan convert plan.geojson scene.json   (GeoJSON / WKT / scene JSON, by extension,
@@ -35,7 +36,7 @@ def _json_dict(text: str) -> dict:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    from .policies import ALGOS
+    from .learning.policies import ALGOS
 
     parser = argparse.ArgumentParser(
         prog="sensorplan",
@@ -60,7 +61,7 @@ def build_parser() -> argparse.ArgumentParser:
         default="sb3",
         help="sb3: a stable-baselines3 baseline (default); rllib: multi-agent PPO with a "
         "shared policy on the watch task (sensorplan_gym.watch_v0) with Ray RLlib, config "
-        "agents/configs/rllib_watch.yaml (see agents.rllib_train)",
+        "agents/configs/rllib_watch.yaml (see agents.learning.rllib_train)",
     )
     t.add_argument(
         "--address",
@@ -155,7 +156,8 @@ def build_parser() -> argparse.ArgumentParser:
         "--backend",
         choices=("local", "ray"),
         default="local",
-        help="ray: play the episodes on Ray workers (same results as local; agents.ray_eval)",
+        help="ray: play the episodes on Ray workers (same results as local; "
+        "agents.evaluation.ray_eval)",
     )
     e.add_argument("--address", default=None, help="ray: an existing Ray cluster's address")
     e.add_argument(
@@ -166,7 +168,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     bm = sub.add_parser(
         "benchmark",
-        help="evaluate policies on the train / test / bundled-scene splits (agents.benchmark)",
+        help="evaluate policies on the train / test / bundled-scene splits "
+        "(agents.evaluation.benchmark)",
         description="Every policy on procedural train and held-out test scenes and on every "
         "bundled scene, with the difficulty knob reported; writes benchmark.json/.csv.",
     )
@@ -310,7 +313,7 @@ def main(argv: list[str] | None = None) -> int:
             )
             return 0
         if args.command == "train" and args.backend == "rllib":
-            from .rllib_train import train_rllib
+            from .learning.rllib_train import train_rllib
 
             res = train_rllib(
                 args.config,
@@ -325,7 +328,7 @@ def main(argv: list[str] | None = None) -> int:
         if args.command == "train":
             if args.env is None or args.algo is None:
                 raise ValueError("--env and --algo are required with --backend sb3")
-            from .train import default_out, train
+            from .learning.train import default_out, train
 
             hp = _hp_overrides(args.hp)
             seeds = args.seeds or [args.seed]
@@ -354,7 +357,7 @@ def main(argv: list[str] | None = None) -> int:
                 )
             return 0
         if args.command == "benchmark":
-            from .benchmark import DEFAULT_DIFFICULTY, benchmark
+            from .evaluation.benchmark import DEFAULT_DIFFICULTY, benchmark
 
             benchmark(
                 args.env,
@@ -369,7 +372,7 @@ def main(argv: list[str] | None = None) -> int:
             )
             return 0
         if args.command == "evaluate":
-            from .evaluate import evaluate
+            from .evaluation.evaluate import evaluate
 
             evaluate(
                 args.env,

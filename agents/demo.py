@@ -242,7 +242,7 @@ def _recognize(out: Path, seed: int) -> tuple[str, str, int]:
 
     import sensorplan_gym  # noqa: F401
 
-    from .oracle import OraclePolicy
+    from .planning.oracle import OraclePolicy
 
     env = gym.make("sensorplan/Recognize-v0", scene="lab", render_mode="rgb_array")
     oracle = OraclePolicy(env)
@@ -310,7 +310,7 @@ def main(argv: list[str] | None = None) -> int:
     from geometry import complete_region
     from sensorplan_gym.core.world import World, WorldConfig, load_scene
 
-    from .oracle import plan_viewpoint
+    from .planning.oracle import plan_viewpoint
 
     scene = load_scene("lab")
     print(f"1. Scene 'lab': {len(scene.obstacles)} furniture footprints, doorway G, watch spot H")
@@ -350,7 +350,7 @@ def main(argv: list[str] | None = None) -> int:
     )
 
     print(f"4. Navigate-v0 (lab), {args.episodes} episodes per policy:")
-    from .evaluate import evaluate, format_table
+    from .evaluation.evaluate import evaluate, format_table
 
     policies = ["oracle", "random"] + _shipped(PRETRAINED)
     res = evaluate(

@@ -110,7 +110,7 @@ def train_sps(vec_env: str, timesteps: int, n_envs: int | None = None, n_steps=N
     by a short warm-up run first."""
     import yaml
 
-    from agents.train import load_hyperparams, train
+    from agents.learning.train import load_hyperparams, train
 
     hp = load_hyperparams("ppo", "sensorplan/Navigate-v0")
     if n_envs is not None:

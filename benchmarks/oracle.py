@@ -19,7 +19,7 @@ import gymnasium as gym
 import numpy as np
 
 import sensorplan_gym  # noqa: F401
-from agents.oracle import OraclePolicy
+from agents.planning.oracle import OraclePolicy
 from geometry.generate import random_scene
 
 ENVS = ["sensorplan/Placement-v0", "sensorplan/Navigate-v0", "sensorplan/Recognize-v0"]

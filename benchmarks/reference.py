@@ -7,19 +7,19 @@
     command that ``--print`` shows.  Hours of CPU for the whole grid; one entry and seed
     takes minutes (README lists them).
 ``python -m benchmarks.reference evaluate [--episodes 100]``
-    runs ``sensorplan benchmark`` (:func:`agents.benchmark.benchmark`) per env on the splits
-    ``train``, ``test`` (held-out procedural scenes) and ``ood`` (every bundled scene, never
-    trained on), with the oracle, the random policy and every trained model found; results
-    in ``runs/reference/<env>[-discrete]/``.  ``--only NAME[:Env-v0] ...`` evaluates just
-    those entries' models and ``--new`` just the models not evaluated yet (into
+    runs ``sensorplan benchmark`` (:func:`agents.evaluation.benchmark.benchmark`) per env on the
+    splits ``train``, ``test`` (held-out procedural scenes) and ``ood`` (every bundled scene,
+    never trained on), with the oracle, the random policy and every trained model found; results
+    in ``runs/reference/<env>[-discrete]/``.  ``--only NAME[:Env-v0] ...`` evaluates just those
+    entries' models and ``--new`` just the models not evaluated yet (into
     ``<env>[-discrete]/models-<entry>/``; ``report`` merges them, a newer result of a model
     replacing an older one).
 ``python -m benchmarks.reference report [--update-results]``
-    the markdown table per env: success per split, the interquartile mean over training
-    seeds with its stratified-bootstrap 95 % interval (:mod:`agents.stats`), the normalized
-    score ``(agent - random) / (oracle - random)`` on the test split and, for Navigate, the
-    mean path length over the oracle's.  Written to ``runs/reference/reference.md``; the
-    tracked ``benchmarks/results/reference.md`` only with ``--update-results``.
+    the markdown table per env: success per split, the interquartile mean over training seeds
+    with its stratified-bootstrap 95 % interval (:mod:`agents.evaluation.stats`), the normalized
+    score ``(agent - random) / (oracle - random)`` on the test split and, for Navigate, the mean
+    path length over the oracle's.  Written to ``runs/reference/reference.md``; the tracked
+    ``benchmarks/results/reference.md`` only with ``--update-results``.
 
 Discrete-action agents (DQN) play the envs with ``action_type="discrete"``, where the
 analytic oracle does not run: their normalized score uses the oracle's success from the
@@ -259,7 +259,7 @@ def _selected(only: list[str] | None) -> list[Entry]:
 def train_grid(entries: list[Entry], seeds: list[int]) -> None:
     """Train every entry x seed whose final model is missing (the commands of ``--print``)."""
     from agents.cli import _hp_overrides
-    from agents.train import train
+    from agents.learning.train import train
 
     for e in entries:
         for s in seeds:
@@ -326,7 +326,7 @@ def evaluate_grid(
     baselines, into ``<group>/models-<entry>/`` (:func:`report` merges them; a model's
     episodes do not depend on which other policies are evaluated with it); ``new``: only
     models not evaluated yet."""
-    from agents.benchmark import benchmark
+    from agents.evaluation.benchmark import benchmark
 
     for env_id in envs or (PLACE, REC, NAV):
         for discrete in (False, True):
@@ -373,7 +373,7 @@ def _models_dir(group: Path, key: str, new: bool) -> Path:
 
 
 def _cell(rates: list[float], seed: int = 0) -> str:
-    from agents.stats import iqm, stratified_bootstrap_ci
+    from agents.evaluation.stats import iqm, stratified_bootstrap_ci
 
     if not rates:
         return "—"
@@ -385,7 +385,7 @@ def _cell(rates: list[float], seed: int = 0) -> str:
 
 def report() -> str:
     """The markdown tables of the evaluated grid."""
-    from agents.policies import model_config
+    from agents.learning.policies import model_config
 
     out = []
     for env_id in (PLACE, REC, NAV):

@@ -29,7 +29,7 @@ demands equality up to the output's rounding.
 * ``hang``: a query that took more than 10 s of CPU time (scenes of at most 60 edges).
 
 ``python -m geometry.fuzz --n 10000 [--swept] [--seed 0]`` runs the long version and
-prints a table; ``tests/test_fuzz.py`` runs a fast one in the default test run.
+prints a table; ``tests/geometry/test_fuzz.py`` runs a fast one in the default test run.
 """
 
 from __future__ import annotations

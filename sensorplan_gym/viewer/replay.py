@@ -100,7 +100,7 @@ def record_rollout(
         obs, _ = env.reset(seed=seed)
         env.action_space.seed(seed)
         if policy == "oracle":
-            from agents.oracle import OraclePolicy
+            from agents.planning.oracle import OraclePolicy
 
             oracle = OraclePolicy(env)
         world = env.unwrapped.world

@@ -1,0 +1,423 @@
+"""The analytic oracle: a privileged planner that acts through a policy interface.
+
+``OraclePolicy(env)`` reads the scene and the exact recognizable region of the
+environment it is bound to and returns actions through
+``predict(obs, state=None, episode_start=None, deterministic=True)``, so SB3's
+``evaluate_policy`` and :mod:`agents.evaluation.evaluate` treat it like a trained model.
+
+What it does (paper section 6, done better):
+
+* **Placement** (6.2): the recognizable region (already computed with the
+  sensor's ``eps_pos``/``eps_aim``) is shrunk by a safety margin and restricted
+  to placements where one aim keeps both swept targets in the field of view;
+  the reachable point nearest the robot is chosen.  When no straight one-step
+  motion exists the robot follows the exact shortest collision-free path (a
+  visibility graph over the grown obstacles, :func:`agents.planning.planner.shortest_path`).
+  When no placement exists, :func:`plan_viewpoint` says so in its result.
+* **Aim** (6.3): the bisector of the angular extent of both swept hulls, which
+  keeps them inside the field of view with the largest margin.
+* **Recognition** (6.4, on range data): readings whose end points do not lie on
+  the static map are target points; :func:`agents.planning.recognition.classify` matches
+  them to the target outline over G and over H by a fractional Hausdorff
+  distance.  "Not seen" makes the oracle re-aim (sweeping the beam fan) and
+  then move closer instead of guessing; only on the very last step of an
+  episode does it fall back to the better-fitting hypothesis.
+
+The oracle never reads the hidden target: only the map, its own commanded pose
+and the sensor readings the agent also gets.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import shapely
+
+from .planner import Placement, best_aim, choose_placement
+from .recognition import classify
+
+__all__ = ["OraclePolicy", "ViewpointPlan", "plan_viewpoint"]
+
+
+@dataclass
+class ViewpointPlan:
+    """Where to look from: ``status`` ``"ok"``, ``"no_placement"`` or ``"unreachable"``;
+    ``point`` (world frame), ``aim`` (radians), ``path`` ((N, 2) way points from the start,
+    world frame, or None), ``length`` (scene units), ``one_step`` and a ``reason``."""
+
+    status: str
+    point: np.ndarray | None = None
+    aim: float = 0.0
+    path: np.ndarray | None = None
+    length: float = math.inf
+    one_step: bool = False
+    reason: str = ""
+    placement: Placement | None = field(default=None, repr=False)
+
+
+def _hull_points(world) -> np.ndarray:
+    return np.vstack(world.must_see)
+
+
+def _aim_for(world, p: np.ndarray) -> tuple[float, float]:
+    psi, margin = best_aim(p, _hull_points(world), world.fov, world.eps_aim)
+    return float(psi), float(margin)
+
+
+def _aim_feasible_region(world, region: shapely.Geometry, n: int = 24) -> shapely.Geometry:
+    """The part of ``region`` where one aim satisfies the field of view, approximated from
+    inside by the cells of an ``n x n`` grid whose four corners all pass the exact check."""
+    if world.fov >= 2 * math.pi - 1e-12 and math.isinf(world.max_range):
+        return region
+    x0, y0, x1, y1 = region.bounds
+    xs = np.linspace(x0, x1, n + 1)
+    ys = np.linspace(y0, y1, n + 1)
+    gx, gy = np.meshgrid(xs, ys, indexing="ij")
+    ok = np.zeros_like(gx, dtype=bool)
+    inside = shapely.contains_xy(region, gx, gy)
+    for i, j in zip(*np.nonzero(inside), strict=False):
+        x, y = gx[i, j], gy[i, j]
+        ok[i, j] = world.aim_ok(x, y, _aim_for(world, np.array([x, y]))[0])
+    good = ok[:-1, :-1] & ok[1:, :-1] & ok[:-1, 1:] & ok[1:, 1:]
+    gi, gj = np.nonzero(good)
+    if len(gi) == 0:
+        return shapely.Polygon()
+    cells = shapely.box(xs[gi], ys[gj], xs[gi + 1], ys[gj + 1])
+    return shapely.intersection(region, shapely.union_all(cells))
+
+
+def plan_viewpoint(
+    world,
+    start_xy: Any,
+    *,
+    keep_out: shapely.Geometry | None = None,
+    margin: float | None = None,
+    joint_aim: bool = True,
+) -> ViewpointPlan:
+    """Choose a recognizing pose reachable from ``start_xy`` (paper 6.2-6.3).
+
+    ``world`` is an environment's :class:`sensorplan_gym.core.world.World`;
+    ``keep_out`` an area the robot must not enter (e.g. where the target may stand);
+    ``margin`` the safety margin the region is shrunk by (default 0.2% of the scene
+    diameter).  With ``joint_aim`` the placement must also admit one aim that keeps both
+    swept targets in the field of view and range (what Placement and Navigate reward);
+    without it any placement of the region will do (a sensor that looks at G and at H in
+    turn).  Never raises for an empty or unreachable region: the result's ``status`` and
+    ``reason`` say what happened.
+    """
+    start = np.asarray(start_xy, dtype=float)
+    margin = 2e-3 * world.diameter if margin is None else float(margin)
+    region = world.region
+    if region.is_empty:
+        return ViewpointPlan("no_placement", reason="the recognizable region is empty")
+    # keep path corners a hair off the obstacles, but never more than the start allows
+    here = shapely.Point(start)
+    if keep_out is not None and keep_out.intersects(here):
+        keep_out = None  # already inside it: cannot keep out
+    room = float(world.free_space.boundary.distance(here))
+    if keep_out is not None:
+        room = min(room, float(keep_out.distance(here)))
+    rr = world.robot_radius
+    clearance = max(rr, min(rr + 1e-4 * world.diameter, rr + 0.25 * (room - rr)))
+
+    def attempt(reg: shapely.Geometry) -> ViewpointPlan:
+        pl = choose_placement(
+            world.scene, reg, start, robot_radius=clearance, margin=margin, keep_out=keep_out
+        )
+        if pl.status != "ok":
+            return ViewpointPlan(pl.status, reason=pl.reason, placement=pl)
+        psi, _ = _aim_for(world, pl.point)
+        return ViewpointPlan(
+            "ok", np.asarray(pl.point), psi, pl.path.points, pl.length, pl.one_step, pl.reason, pl
+        )
+
+    plan = attempt(region)
+    if plan.status == "ok" and (not joint_aim or world.aim_ok(*plan.point, plan.aim)):
+        return plan
+    feasible = _aim_feasible_region(world, region)
+    if feasible.is_empty:
+        return ViewpointPlan(
+            "no_placement",
+            reason="no placement of the recognizable region "
+            "keeps both swept targets in the field of view and range",
+        )
+    plan = attempt(feasible)
+    if plan.status == "ok" and not world.aim_ok(*plan.point, plan.aim):
+        plan.status, plan.reason = "no_placement", "the chosen point fails the aim check"
+    return plan
+
+
+def _wrap(a: float) -> float:
+    return (a + math.pi) % (2 * math.pi) - math.pi
+
+
+class _Driver:
+    """Per-episode controller of one robot env (Navigate-v0 / Recognize-v0)."""
+
+    def __init__(self, env) -> None:
+        self.env = env
+        self.plan: ViewpointPlan | None = None
+        self.waypoints: list[np.ndarray] = []
+        self.steps = 0
+        self.stuck = 0
+        self.last_xy: np.ndarray | None = None
+        self.points: list[np.ndarray] = []
+        self.dither = 0
+        self.looking = False  # arrived at the viewpoint once: now observing
+        self.n_classified = -1
+        self.decision = None
+        self.latched = 0.0  # a declaration, repeated until the env takes it (declare_hold)
+        self.looks: list[float] | None = None
+
+    # -- planning -----------------------------------------------------------------------
+    def _replan(self) -> None:
+        w = self.env.world
+        x, y, _ = self.env.pose
+        keep_out = None
+        if self.env.spec_kind == "recognize":
+            keep_out = shapely.union(
+                *(shapely.convex_hull(shapely.multipoints(k)) for k in w.must_see)
+            )
+        self.plan = plan_viewpoint(w, (x, y), keep_out=keep_out)
+        self.looks = None
+        if self.plan.status != "ok" and self.env.spec_kind == "recognize":
+            # no single aim sees both: stand anywhere in the region, look at G, then at H
+            self.plan = plan_viewpoint(w, (x, y), keep_out=keep_out, joint_aim=False)
+            if self.plan.status == "ok":
+                p = self.plan.point
+                self.looks = [best_aim(p, k, w.fov, w.eps_aim)[0] for k in w.must_see]
+                self.plan.aim = self.looks[0]
+        self.waypoints = [] if self.plan.status != "ok" else [p for p in self.plan.path[1:]]
+
+    # -- motion -------------------------------------------------------------------------
+    def drive(self) -> np.ndarray:
+        """Action ``(forward, lateral, turn)`` following the plan and turning to its aim."""
+        env = self.env
+        x, y, psi = env.pose
+        pos = np.array([x, y])
+        if self.plan is None:
+            self._replan()
+        if (
+            self.last_xy is not None
+            and self.waypoints
+            and np.allclose(pos, self.last_xy, atol=1e-12)
+        ):
+            self.stuck += 1
+            if self.stuck >= 3:
+                self._replan()
+                self.stuck = 0
+        self.last_xy = pos
+        v = env.max_speed
+        box = getattr(env, "speed_limit", "box") == "box"
+        move = np.zeros(2)
+        if self.waypoints:
+            # the action square ("box" speed limit) allows sqrt(2) * v along the robot's
+            # diagonals: go as far along the current leg as the limit permits (never past
+            # its corner); a "disc" limit allows v in every direction
+            d = self.waypoints[0] - pos
+            dist = float(np.hypot(*d))
+            rel = math.atan2(d[1], d[0]) - psi
+            reach = v / max(abs(math.cos(rel)), abs(math.sin(rel)), 1e-12) if box else v
+            if dist <= reach:
+                move = d
+                self.waypoints.pop(0)
+            else:
+                move = d * (reach / dist)
+        aim = self.plan.aim if self.plan is not None and self.plan.status == "ok" else psi
+        left = sum(
+            float(np.hypot(*(b - a)))
+            for a, b in zip([pos + move, *self.waypoints[:-1]], self.waypoints, strict=False)
+        )
+        if box and self.waypoints and left > math.sqrt(2) * v:
+            # still travelling: turn so that the next leg runs along a diagonal
+            nxt = self.waypoints[0] - (pos + move)
+            travel = math.atan2(nxt[1], nxt[0])
+            aim = min(
+                (travel - math.pi / 4, travel + math.pi / 4), key=lambda a: abs(_wrap(a - psi))
+            )
+        c, s = math.cos(psi), math.sin(psi)
+        fwd = (c * move[0] + s * move[1]) / v
+        lat = (-s * move[0] + c * move[1]) / v
+        turn = float(np.clip(_wrap(aim - psi) / env.max_turn, -1.0, 1.0))
+        return np.array([fwd, lat, turn], dtype=np.float32)
+
+    @property
+    def arrived(self) -> bool:
+        if self.plan is None or self.plan.status != "ok" or self.waypoints:
+            return False
+        x, y, psi = self.env.pose
+        return abs(_wrap(self.plan.aim - psi)) < 1e-9
+
+    # -- recognition --------------------------------------------------------------------
+    def observe_target(self) -> None:
+        env, w = self.env, self.env.world
+        scan = env.scan
+        if scan is None:
+            return
+        dist, _, hit, ang = scan
+        x, y, _ = env.pose
+        pts = np.stack([x + dist * np.cos(ang), y + dist * np.sin(ang)], axis=1)[hit]
+        if len(pts) == 0:
+            return
+        tol = max(3.0 * env.sensor.noise, w.eps_pos, w.range_acc) + 1e-3 * w.diameter
+        static = shapely.distance(shapely.points(pts), w.scene.free_space.boundary)
+        self.points.extend(pts[static > tol])
+
+    def decide(self, final: bool) -> float:
+        """``decide`` component: -1 declares G, +1 declares H, 0 continues."""
+        n = len(self.points)
+        if (n < 3 or n == self.n_classified) and not final:
+            return 0.0
+        self.n_classified = n
+        w = self.env.world
+        pts = np.asarray(self.points) if self.points else np.empty((0, 2))
+        tol = max(3.0 * self.env.sensor.noise, w.eps_pos, w.range_acc)
+        if w.theta is None:  # orientation unknown: a coarser search over the circle
+            tau = max(0.15 * w.target_radius, 2.5 * tol)
+            res = tau / 2
+        else:
+            tau = max(0.05 * w.target_radius, 2.5 * tol)
+            res = None
+        dec = classify(
+            pts,
+            np.ones(len(pts), dtype=bool),
+            w.scene,
+            goal=w.goal_geom,
+            failure=w.failure_geom,
+            theta=w.theta,
+            tau=tau,
+            resolution=res,
+        )
+        self.decision = dec
+        if dec.label == "G":
+            return -1.0
+        if dec.label == "H":
+            return 1.0
+        if final:  # last chance: the better-fitting hypothesis beats a certain timeout
+            return -1.0 if dec.d_G <= dec.d_H else 1.0
+        return 0.0
+
+
+class OraclePolicy:
+    """Privileged planner with an SB3-style ``predict``.
+
+    Parameters
+    ----------
+    env : a Gymnasium env of this package (wrappers are looked through) or an SB3
+        ``DummyVecEnv`` of them.  ``SubprocVecEnv`` cannot be read from and is rejected.
+    """
+
+    def __init__(self, env) -> None:
+        envs = getattr(env, "envs", None)
+        if envs is None and hasattr(env, "remotes"):
+            raise TypeError(
+                "OraclePolicy needs in-process envs: use DummyVecEnv, not SubprocVecEnv"
+            )
+        self.vectorized = envs is not None
+        self.envs = [e.unwrapped for e in (envs if envs is not None else [env])]
+        for e in self.envs:
+            kind = type(e).__name__
+            if kind not in ("PlacementEnv", "NavigateEnv", "RecognizeEnv"):
+                raise TypeError(f"OraclePolicy supports the sensorplan envs, got {kind}")
+            if getattr(e.batch, "action_type", "continuous") != "continuous":
+                raise TypeError(
+                    "OraclePolicy acts in the continuous action space; make the env with "
+                    "action_type='continuous' (the default)"
+                )
+            e.spec_kind = kind.replace("Env", "").lower()
+        self.drivers = [_Driver(e) for e in self.envs]
+
+    def reset(self) -> None:
+        """Forget all episode state (called automatically at episode starts)."""
+        self.drivers = [_Driver(e) for e in self.envs]
+
+    def predict(
+        self,
+        observation: Any,
+        state: Any = None,
+        episode_start: Any = None,
+        deterministic: bool = True,
+    ) -> tuple[np.ndarray, Any]:
+        """Actions for the current state of the bound env(s); ``(actions, state)`` as in SB3."""
+        starts = (
+            np.zeros(len(self.envs), dtype=bool)
+            if episode_start is None
+            else np.atleast_1d(np.asarray(episode_start, dtype=bool))
+        )
+        actions = []
+        for i, env in enumerate(self.envs):
+            drv = self.drivers[i]
+            new = bool(starts[i]) if i < len(starts) else False
+            if (
+                not new
+                and env.spec_kind != "placement"
+                and drv.steps > 0
+                and env.pose is not None
+                and np.allclose(env.pose, env.start, atol=0)
+            ):
+                new = True  # the env was reset behind our back
+            if new:
+                drv = self.drivers[i] = _Driver(env)
+            actions.append(self._act(env, drv))
+            drv.steps += 1
+        out = np.stack(actions)
+        return (out if self.vectorized else out[0]), state
+
+    # -- per env --------------------------------------------------------------------------
+    def _act(self, env, drv: _Driver) -> np.ndarray:
+        if env.spec_kind == "placement":
+            return self._place(env)
+        if drv.plan is None:
+            drv._replan()
+        a = drv.drive()
+        if env.spec_kind == "navigate":
+            return a
+        # Recognize: look once there, sweep the fan of beams, then decide
+        decide = 0.0
+        horizon = env.max_steps or (env.spec.max_episode_steps if env.spec else None) or 200
+        final = drv.steps >= horizon - 1
+        drv.looking = drv.looking or drv.arrived
+        if drv.latched:
+            decide = drv.latched
+        elif drv.looking or final or drv.plan.status != "ok":
+            drv.observe_target()
+            decide = drv.decide(final)
+            drv.latched = decide
+            if decide == 0.0 and drv.looking:
+                # re-aim: sweep the gaps between beams around the planned aim (or around
+                # the aims at G and at H in turn when no single aim sees both): a triangle
+                # wave over one beam spacing, with a step incommensurate with it so that
+                # later passes fall between earlier ones, and never faster than a turn
+                spacing = (
+                    2 * math.pi if env.sensor.fov >= 2 * math.pi - 1e-12 else env.sensor.fov
+                ) / max(env.sensor.n_beams, 1)
+                drv.dither += 1
+                looks = drv.looks or [drv.plan.aim]
+                base = looks[(drv.dither // 16) % len(looks)]
+                step = min(0.1459 * spacing, 0.9 * env.max_turn)
+                phase = (drv.dither * step / spacing) % 2.0
+                offset = spacing * ((phase if phase <= 1.0 else 2.0 - phase) - 0.5)
+                a[2] = np.clip(_wrap(base + offset - env.pose[2]) / env.max_turn, -1, 1)
+        return np.array([a[0], a[1], a[2], decide], dtype=np.float32)
+
+    def _place(self, env) -> np.ndarray:
+        w = env.world
+        region = w.region
+        if region.is_empty:
+            return np.zeros(3, dtype=np.float32)
+        feasible = _aim_feasible_region(w, region)
+        if feasible.is_empty:
+            feasible = region
+        # the most robust placement: the pole of inaccessibility of the largest part
+        parts = shapely.get_parts(feasible)
+        big = parts[np.argmax(shapely.area(parts))]
+        p = np.asarray(
+            shapely.maximum_inscribed_circle(big, 1e-4 * w.diameter).boundary.geoms[0].coords[0]
+        )
+        psi, _ = _aim_for(w, p)
+        lo, hi = w.lo, w.hi
+        xy = 2 * (p - lo) / (hi - lo) - 1
+        return np.array([xy[0], xy[1], _wrap(psi) / math.pi], dtype=np.float32)

@@ -1,0 +1,1 @@
+"""Tests of the benchmarks part of the code."""

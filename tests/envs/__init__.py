@@ -1,0 +1,1 @@
+"""Tests of the envs part of the code."""

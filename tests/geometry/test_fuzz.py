@@ -1,0 +1,125 @@
+"""Fuzzing every query type on degenerate scenes (issue 10; :mod:`geometry.fuzz`).
+
+Fast version in the default run: hypothesis draws generator seeds (touching, flush and
+collinear obstacles, slivers, obstacles touching the target's hull, rounded and scaled
+coordinates) and every finding of :func:`geometry.fuzz.check_scene` fails the test:
+crashes, invalid output, output outside the free space, violated inclusions, unsafe
+members of complete regions, translation variance, queries over 10 s.  The seeds that
+exposed bugs during development are pinned.  Long version: ``python -m geometry.fuzz
+--n 10000 [--swept]`` or ``SENSORPLAN_SLOW=1 pytest -m slow tests/geometry/test_fuzz.py``.
+"""
+
+from __future__ import annotations
+
+import os
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from geometry import Scene, recognizable_region
+from geometry.fuzz import check_scene, fuzz_scene, run_many
+
+#: Seeds that failed before the fixes of issue 10 (each a different root cause):
+#: 27 and 37 -- output folded invalid by the rounding of the mapping back to world
+#: coordinates; 223 -- a fan from a target vertex inside an obstacle lying flush on the
+#: target (partial region inside the obstacle); 440, 481, 496 -- an obstacle flush on a
+#: hull edge whose wedge was pruned by an exact-zero side test (unsafe complete region);
+#: 100833, 2424114 -- GEOS overlays misfiring on a region whose hole touches its shell (the
+#: checker confirms areas by point tests); 102667 -- a ring twisted by the rounding of the
+#: mapping back at a 3.2e5 offset (302211, 309618: holes; now snap-rounded onto the world's
+#: grid before mapping); 106185 -- GEOS buffer disc sums cutting into the disc.
+REGRESSION_SEEDS = [27, 37, 223, 440, 481, 496, 100833, 102667, 106185, 302211, 309618, 2424114]
+
+#: Swept-query seeds: 410993, 411063, 421105 -- the union of the sweep's pieces (sampled
+#: shadows with collapsed parts a few ulps wide, and traced quads) by GEOS's floating-point
+#: overlay silently lost up to half a shadow, so the swept partial region held placements
+#: blinded at a vertex of G ("translating ⊆ stationary (partial)"); now snap-rounded.
+#: 501057 -- GEOS's union of two sampled shadows carried collapsed LineStrings and the next
+#: overlay raised "Result area inconsistent with overlay operation" (a crash).
+#: 506058 -- the weak visibility region's hole around the target is the target with its
+#: vertices moved by an ulp (fan ends are computed ray hits); GEOS's floating union of the
+#: two was invalid ("nested shells") and the shadow's difference raised TopologyException
+#: "unable to assign free hole to a shell" (a crash); now the shadow is snap-rounded.
+SWEPT_REGRESSION_SEEDS = [410993, 411063, 421105, 501057, 506058]
+
+
+def _assert_clean(seed: int, swept: bool = False) -> None:
+    d = fuzz_scene(seed)
+    if d is None:
+        return
+    # wall-clock limit of a query: generous here (2 shared cores under pytest -n 2); the
+    # 10 s limit of issue 10 is checked by the long run (python -m geometry.fuzz)
+    findings, _ = check_scene(d, swept=swept, seed=seed, hang_s=60.0)
+    assert not findings, f"seed {seed} {d.get('features')}: {[vars(f) for f in findings]}"
+
+
+@pytest.mark.parametrize("seed", REGRESSION_SEEDS)
+def test_regression_seeds(seed):
+    _assert_clean(seed)
+
+
+@pytest.mark.parametrize("seed", SWEPT_REGRESSION_SEEDS)
+def test_swept_regression_seeds(seed):
+    _assert_clean(seed, swept=True)
+
+
+def test_swept_5_2_does_not_bisect_for_unconfirmed_edges(monkeypatch):
+    """Fuzz seed 507801: merging short ring edges before labelling (seed 506058's fix)
+    exposed a shadow edge that the exact point test never confirms, not even at its own
+    sample, and the coverage-gap rule bisected for it to the depth limit on every edge of
+    H (157 refinements, 11.9-15 s for the 5.2 query, a "hang"; 0 refinements before).
+    Lines not confirmed at both ends of an interval no longer call for refinement."""
+    import geometry.partial as partial
+
+    stats = []
+    swept = partial.swept_shadows
+
+    def spy(*a, **k):
+        out = swept(*a, **k)
+        stats.append(out[1])
+        return out
+
+    monkeypatch.setattr(partial, "swept_shadows", spy)
+    d = fuzz_scene(507801)
+    s = Scene.from_dict({k: v for k, v in d.items() if k != "features"})
+    theta = 0.32877895673336477  # the one check_scene draws for this seed
+    r = recognizable_region(s, model="partial", theta=theta, conservative=True)
+    assert r.area > 0 and len(stats) == 2
+    assert sum(st["refined"] for st in stats) <= 8, stats
+
+
+@settings(max_examples=60, deadline=None)
+@given(seed=st.integers(min_value=0, max_value=2**31 - 1))
+def test_fuzz_stationary_and_complete(seed):
+    _assert_clean(seed)
+
+
+@settings(max_examples=3, deadline=None)
+@given(seed=st.integers(min_value=0, max_value=2**31 - 1))
+def test_fuzz_swept(seed):
+    _assert_clean(seed, swept=True)
+
+
+def test_generator_makes_valid_degenerate_scenes():
+    feats: set[str] = set()
+    valid = 0
+    for seed in range(60):
+        d = fuzz_scene(seed)
+        if d is None:
+            continue
+        feats.update(d["features"])
+        Scene.from_dict({k: v for k, v in d.items() if k != "features"})
+        valid += 1
+    assert valid >= 55
+    assert {"flush_wall", "shared_edge", "t_junction", "sliver", "touch_hull"} <= feats
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(
+    not os.environ.get("SENSORPLAN_SLOW"),
+    reason="long: set SENSORPLAN_SLOW=1 (and use -m slow) to run",
+)
+def test_fuzz_long():
+    res = run_many(int(os.environ.get("SENSORPLAN_FUZZ_N", "10000")), seed=10_000)
+    assert not res["violations"], res["failing_scenes"][:20]

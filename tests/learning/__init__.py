@@ -1,0 +1,1 @@
+"""Tests of the learning part of the code."""

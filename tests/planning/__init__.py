@@ -1,0 +1,1 @@
+"""Tests of the planning part of the code."""

@@ -1,0 +1,1 @@
+"""Tests of the viewer part of the code."""
