@@ -3,7 +3,7 @@
     sensorplan view lab                      live viewer at http://localhost:5006/
     sensorplan view my_scene.json --model partial --motion stationary
     sensorplan view lab --export view.html   one self-contained HTML file, no server
-    sensorplan view lab --rollout ep.json    adds a Replay tab (see sensorplan_gym.viewer.replay)
+    sensorplan view lab --rollout ep.json    adds a Replay tab (record one: sensorplan record)
 
 Needs the ``viewer`` extra (Bokeh): ``pip install -e ".[viewer]"``.
 """

@@ -222,9 +222,12 @@ def test_cli_export(tmp_path, capsys):
 
 @pytest.fixture(scope="module")
 def rollout():
+    from agents import OraclePolicy
     from sensorplan_gym.viewer.replay import record_rollout
 
-    return record_rollout("sensorplan/Recognize-v0", policy="oracle", seed=0, scene="lab")
+    return record_rollout(
+        "sensorplan/Recognize-v0", policy=OraclePolicy, policy_name="oracle", seed=0, scene="lab"
+    )
 
 
 def test_record_rollout(rollout, tmp_path):
