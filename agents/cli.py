@@ -1,4 +1,5 @@
-"""``sensorplan`` command line: ``train``, ``evaluate`` and ``demo``.
+"""``sensorplan`` command line (also ``python -m agents``): ``train``, ``evaluate``,
+``benchmark``, ``demo``, ``convert``, ``view`` and ``record``.
 
     sensorplan train --env sensorplan/Navigate-v0 --algo ppo --timesteps 150000 --seed 0 --n-envs 2
     sensorplan evaluate --env sensorplan/Navigate-v0 --policies oracle random \\
@@ -12,6 +13,8 @@
                                                   lab.geojson; see geometry.formats)
     sensorplan view lab        (scenes and exact regions in the browser; --export view.html
                                 writes one self-contained file; see sensorplan_gym.viewer)
+    sensorplan record --policy oracle --out ep.json   (one episode for sensorplan view
+                                                        --rollout ep.json)
 """
 
 from __future__ import annotations
@@ -43,7 +46,7 @@ def build_parser() -> argparse.ArgumentParser:
         description="Sensor planning (Briggs & Donald): train and evaluate agents, run the demo.",
     )
     sub = parser.add_subparsers(
-        dest="command", metavar="{train,evaluate,benchmark,demo,convert,view}"
+        dest="command", metavar="{train,evaluate,benchmark,demo,convert,view,record}"
     )
     sub.required = True
 
@@ -223,6 +226,27 @@ def build_parser() -> argparse.ArgumentParser:
     )
     c.add_argument("output", help="output file (.json, .geojson or .wkt)")
     c.add_argument("--name", default=None, help="scene name (default: from the input)")
+
+    r = sub.add_parser(
+        "record",
+        help="record one episode to a rollout file for `sensorplan view --rollout`",
+        description="Play one episode with a policy and save it (poses, beams, target, the "
+        "exact region) as rollout JSON; `sensorplan view SCENE --rollout FILE` replays it "
+        "(see sensorplan_gym.viewer.replay).",
+    )
+    r.add_argument("--env", default="sensorplan/Recognize-v0", help=ENV_CHOICES_HELP)
+    r.add_argument(
+        "--policy", default="oracle", help="'oracle' (default), 'random' or a model zip path"
+    )
+    r.add_argument(
+        "--scene",
+        default="lab",
+        help="bundled scene name or scene file: scene JSON, GeoJSON or WKT (default: lab)",
+    )
+    r.add_argument("--seed", type=int, default=0)
+    r.add_argument("--max-steps", type=int, default=None)
+    r.add_argument("--env-kwargs", type=_json_dict, default=None, help="JSON gym.make kwargs")
+    r.add_argument("--out", default="rollout.json", help="rollout file (default rollout.json)")
     return parser
 
 
@@ -277,6 +301,31 @@ def _hp_overrides(items: list[str] | None) -> dict:
     return out
 
 
+def _record(args: argparse.Namespace) -> int:
+    """``sensorplan record``: the viewer's recorder (below the agents) gets the policy from
+    here (:func:`agents.learning.policies.load_policy`)."""
+    from sensorplan_gym.viewer.replay import record_rollout, save_rollout
+
+    from .learning.policies import load_policy
+
+    spec = args.policy
+    if spec == "random":
+        policy: object = "random"
+    else:
+        policy = lambda env: load_policy(spec, env, seed=args.seed)  # noqa: E731
+    ro = record_rollout(
+        args.env,
+        policy=policy,
+        policy_name=spec,
+        seed=args.seed,
+        max_steps=args.max_steps,
+        **{**(args.env_kwargs or {}), "scene": args.scene},
+    )
+    p = save_rollout(ro, args.out)
+    print(f"wrote {p}: {len(ro['steps']) - 1} steps, return {ro['return']:.3f}")
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     if argv and argv[0] == "demo":
@@ -312,6 +361,8 @@ def main(argv: list[str] | None = None) -> int:
                 f"{len(scene.obstacles)} obstacles, {n_edges} edges"
             )
             return 0
+        if args.command == "record":
+            return _record(args)
         if args.command == "train" and args.backend == "rllib":
             from .learning.rllib_train import train_rllib
 

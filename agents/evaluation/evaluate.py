@@ -43,52 +43,14 @@ from typing import Any
 import numpy as np
 
 from ..learning.policies import load_policy, make_env, model_config, policy_label
+from .episodes import EVAL_SEED_BASE, run_episodes
+from .ray_eval import run_episodes_ray
 from .stats import iqm, normalized_score, stratified_bootstrap_ci, wilson_interval
 
 __all__ = ["EVAL_SEED_BASE", "evaluate", "format_table", "run_episodes"]
 
-#: evaluation episode ``i`` is reset with seed ``EVAL_SEED_BASE + seed + i``
-EVAL_SEED_BASE = 1_000_000
 # env kwargs that change only the reward, not what the agent sees or how the world behaves
 _REWARD_ONLY = {"shaping", "step_cost", "success_bonus"}
-
-
-def _xy(info: dict) -> np.ndarray | None:
-    pose = info.get("pose")
-    if pose is None:
-        return None
-    return np.asarray(pose[:2], dtype=float)
-
-
-def run_episodes(env, policy, seeds: list[int], *, deterministic: bool = True) -> dict[str, list]:
-    """Play one episode per seed; per-episode success, return, steps and path length."""
-    out: dict[str, list] = {"success": [], "return": [], "steps": [], "path_length": []}
-    for s in seeds:
-        obs, info = env.reset(seed=int(s))
-        state = None
-        start = np.ones(1, dtype=bool)
-        prev = _xy(info)
-        ret, steps, path = 0.0, 0, 0.0
-        done = False
-        while not done:
-            action, state = policy.predict(
-                obs, state=state, episode_start=start, deterministic=deterministic
-            )
-            start = np.zeros(1, dtype=bool)
-            obs, reward, terminated, truncated, info = env.step(action)
-            ret += float(reward)
-            steps += 1
-            xy = _xy(info)
-            if xy is not None and prev is not None:
-                path += float(np.hypot(*(xy - prev)))
-            if xy is not None:
-                prev = xy
-            done = terminated or truncated
-        out["success"].append(bool(info.get("is_success", False)))
-        out["return"].append(ret)
-        out["steps"].append(steps)
-        out["path_length"].append(path)
-    return out
 
 
 def _summary(name: str, spec: str, ep: dict[str, list], meta: dict) -> dict[str, Any]:
@@ -301,8 +263,6 @@ def evaluate(
 
                 torch.manual_seed(seed)  # stochastic actions repeat exactly
             if backend == "ray":
-                from .ray_eval import run_episodes_ray
-
                 ep = run_episodes_ray(
                     env_id,
                     env_kwargs,

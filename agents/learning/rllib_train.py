@@ -13,7 +13,7 @@ Writes to ``--out`` (default ``runs/rllib_watch_s<seed>``): ``config.yaml`` (the
 config, with the seed and the Ray/RLlib version), ``progress.jsonl`` (one line per iteration:
 env steps, mean episode return, wall time) and ``checkpoint/`` (``algo.save``).
 :class:`RLlibWatchPolicy` loads the shared module from such a checkpoint for evaluation
-(``python -m agents.planning.watch_oracle --policy runs/.../checkpoint``).
+(``python -m agents.evaluation.watch --policy runs/.../checkpoint``).
 """
 
 from __future__ import annotations

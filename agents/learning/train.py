@@ -44,7 +44,6 @@ import multiprocessing
 import os
 import platform
 import shutil
-import sys
 import time
 import warnings
 from pathlib import Path
@@ -597,9 +596,3 @@ def train(
             flush=True,
         )
     return record
-
-
-if __name__ == "__main__":  # pragma: no cover
-    from ..cli import main
-
-    sys.exit(main(["train", *sys.argv[1:]]))

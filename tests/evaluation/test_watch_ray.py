@@ -27,7 +27,7 @@ def test_ray_backends(tmp_path):
 
 
 def _watch_evaluation_matches_local():
-    from agents.planning.watch_oracle import evaluate_watch
+    from agents.evaluation.watch import evaluate_watch
 
     for policy in ("oracle", "random"):
         kw = dict(policy=policy, episodes=4, seed=3, chunk=2)
@@ -62,8 +62,8 @@ def _rllib_shared_policy_smoke(tmp_path):
 
     import yaml
 
+    from agents.evaluation.watch import run_watch_episodes
     from agents.learning.rllib_train import RLlibWatchPolicy, load_config
-    from agents.planning.watch_oracle import run_watch_episodes
 
     cfg = load_config()
     cfg["env"].update(max_steps=30, move_steps=15)
