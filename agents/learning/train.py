@@ -52,6 +52,7 @@ from typing import Any
 import numpy as np
 import yaml
 
+from ..checks import check_writable_dir
 from .policies import ALGOS, algo_class, make_env
 
 __all__ = [
@@ -367,7 +368,7 @@ def train(
         raise ValueError(f"eval_env_kwargs must be a mapping of env kwargs, got {eval_kw!r}")
     hyperparams = copy.deepcopy(hp)  # as written in the YAML, for the record
 
-    out = Path(out) if out is not None else default_out(algo, env_id, seed)
+    out = check_writable_dir(out if out is not None else default_out(algo, env_id, seed))
     if threads:
         torch.set_num_threads(int(threads))
     out.mkdir(parents=True, exist_ok=True)
