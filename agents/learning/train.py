@@ -52,6 +52,8 @@ from typing import Any
 import numpy as np
 import yaml
 
+import sensorplan_gym
+
 from ..checks import check_writable_dir
 from .policies import ALGOS, algo_class, make_env
 
@@ -83,20 +85,9 @@ _META_KEYS = (
 
 
 def package_version() -> str:
-    """The installed ``sensorplan-gym`` version (read from pyproject.toml in a checkout)."""
-    try:
-        from importlib.metadata import version
-
-        return version("sensorplan-gym")
-    except Exception:  # noqa: BLE001 - not installed: read the checkout's pyproject
-        pyproject = Path(__file__).resolve().parents[2] / "pyproject.toml"
-        try:
-            import tomllib
-
-            with open(pyproject, "rb") as f:
-                return str(tomllib.load(f)["project"]["version"])
-        except Exception:  # noqa: BLE001
-            return "unknown"
+    """The ``sensorplan-gym`` version of the code that runs (``sensorplan_gym.__version__``,
+    the one place it is written; an editable install's metadata can lag behind it)."""
+    return sensorplan_gym.__version__
 
 
 def _short(env_id: str) -> str:
