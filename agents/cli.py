@@ -23,7 +23,9 @@ import argparse
 import json
 import sys
 
-__all__ = ["build_parser", "main"]
+from .checks import EXTRA_OF_MODULE, check_writable_file, missing_extra_message
+
+__all__ = ["EXTRA_OF_MODULE", "build_parser", "main"]
 
 ENV_CHOICES_HELP = "sensorplan/Placement-v0, sensorplan/Navigate-v0 or sensorplan/Recognize-v0"
 
@@ -250,33 +252,10 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-#: top-level modules of the optional extras -> the extra that installs them
-EXTRA_OF_MODULE = {
-    "yaml": "rl",
-    "stable_baselines3": "rl",
-    "sb3_contrib": "rl",
-    "torch": "rl",
-    "tqdm": "rl",
-    "rich": "rl",
-    "tensorboard": "rl",
-    "pettingzoo": "multi",
-    "ray": "multi",
-    "bokeh": "viewer",
-}
-
-
 def _missing_extra_message(command: str, err: ImportError) -> str | None:
-    """The 'install this extra' message for an ImportError of an optional dependency, or
-    ``None`` when the missing module belongs to no extra (a real bug: re-raise it)."""
-    name = (getattr(err, "name", None) or "").split(".")[0]
-    extra = EXTRA_OF_MODULE.get(name)
-    if extra is None:
-        return None
-    return (
-        f"sensorplan {command}: error: the Python module {name!r} is missing; it comes with "
-        f'the "{extra}" extra: pip install -e ".[{extra}]" in a checkout, '
-        f'pip install "sensorplan-gym[{extra}]" otherwise'
-    )
+    """The 'install this extra' message of ``sensorplan <command>`` for an ImportError of an
+    optional dependency, or ``None`` when the module belongs to no extra (re-raise it)."""
+    return missing_extra_message(f"sensorplan {command}", err)
 
 
 def _hp_overrides(items: list[str] | None) -> dict:
@@ -306,9 +285,11 @@ def _record(args: argparse.Namespace) -> int:
     here (:func:`agents.learning.policies.load_policy`)."""
     from sensorplan_gym.viewer.replay import record_rollout, save_rollout
 
-    from .learning.policies import load_policy
+    from .learning.policies import check_policies, load_policy
 
+    check_writable_file(args.out)
     spec = args.policy
+    check_policies([spec])
     if spec == "random":
         policy: object = "random"
     else:
@@ -447,6 +428,10 @@ def main(argv: list[str] | None = None) -> int:
     except (ValueError, KeyError, FileNotFoundError, NotImplementedError) as err:
         msg = err.args[0] if isinstance(err, KeyError) and err.args else err
         print(f"sensorplan {args.command}: error: {msg}", file=sys.stderr)
+        return 2
+    except OSError as err:  # e.g. a folder that became unwritable while running
+        where = f": {err.filename}" if err.filename else ""
+        print(f"sensorplan {args.command}: error: {err.strerror or err}{where}", file=sys.stderr)
         return 2
     return 1  # pragma: no cover - argparse rejects unknown commands
 

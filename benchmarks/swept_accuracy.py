@@ -14,7 +14,7 @@ per edge of G (a subset of the true union):
 
 from __future__ import annotations
 
-import sys
+import argparse
 
 import numpy as np
 import shapely
@@ -26,8 +26,13 @@ from geometry.sweep import Sweeper, swept_shadows
 
 
 def main(argv: list[str] | None = None) -> None:
-    args = sys.argv[1:] if argv is None else argv
-    first, last = (int(args[0]), int(args[1])) if len(args) >= 2 else (0, 10)
+    ap = argparse.ArgumentParser(
+        prog="python -m benchmarks.swept_accuracy", description=__doc__.split("\n\n")[0]
+    )
+    ap.add_argument("first_seed", nargs="?", type=int, default=0, help="default 0")
+    ap.add_argument("last_seed", nargs="?", type=int, default=10, help="default 10")
+    args = ap.parse_args(argv)
+    first, last = args.first_seed, args.last_seed
     for seed in range(first, last):
         rng = np.random.default_rng(seed)
         sc = Scene.from_dict(random_scene(rng, goal="polygon", n_obstacles=8))

@@ -42,7 +42,14 @@ from typing import Any
 
 import numpy as np
 
-from ..learning.policies import load_policy, make_env, model_config, policy_label
+from ..checks import check_writable_dir
+from ..learning.policies import (
+    check_policies,
+    load_policy,
+    make_env,
+    model_config,
+    policy_label,
+)
 from .episodes import EVAL_SEED_BASE, run_episodes
 from .ray_eval import run_episodes_ray
 from .stats import iqm, normalized_score, stratified_bootstrap_ci, wilson_interval
@@ -204,6 +211,13 @@ def evaluate(
         raise ValueError(f"episodes must be positive, got {episodes}")
     if not policies:
         raise ValueError("no policies to evaluate")
+    check_policies(policies)  # every path, before any episode is played
+    if out is not False:
+        outdir = check_writable_dir(
+            out
+            if out is not None
+            else Path("runs") / f"eval_{env_id.split('/')[-1].split('-v')[0].lower()}_s{seed}"
+        )
     if env_id not in gym.registry:
         raise ValueError(
             f"unknown env id {env_id!r}; sensorplan ids: {', '.join(sensorplan_gym.ENV_IDS)}"
@@ -321,11 +335,6 @@ def evaluate(
             }
 
     if out is not False:
-        outdir = (
-            Path(out)
-            if out is not None
-            else Path("runs") / f"eval_{env_id.split('/')[-1].split('-v')[0].lower()}_s{seed}"
-        )
         outdir.mkdir(parents=True, exist_ok=True)
         files = {"json": str(outdir / "results.json"), "csv": str(outdir / "results.csv")}
         if plot:

@@ -31,10 +31,11 @@ def ensure_ray(address: str | None = None, num_cpus: int | None = None):
     instance with ``num_cpus`` CPUs (default: all); reused when already initialised."""
     try:
         import ray
-    except ImportError as e:  # pragma: no cover - exercised without the extra
+    except ImportError as e:
         raise ImportError(
-            "the Ray backend needs Ray: pip install -e '.[multi]' (ray[rllib], pettingzoo)"
-        ) from e
+            "the Ray backend needs Ray: pip install -e '.[multi]' (ray[rllib], pettingzoo)",
+            name=e.name or "ray",
+        ) from None
     if not ray.is_initialized():
         # the workers import sensorplan-gym from their Python environment: on a cluster,
         # install the same version on every node

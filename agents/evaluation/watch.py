@@ -15,11 +15,13 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 import time
 from typing import Any
 
 import numpy as np
 
+from ..checks import check_writable_file, missing_extra_message
 from ..learning.rllib_train import RLlibWatchPolicy
 from ..planning.watch_oracle import WatchOracle
 from .episodes import EVAL_SEED_BASE
@@ -179,19 +181,31 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--address", default=None, help="Ray cluster address (backend ray)")
     ap.add_argument("--json", default=None, help="write the rows (with per-episode data) here")
     args = ap.parse_args(argv)
-    policy: Any = args.policy
-    if policy not in ("oracle", "random"):
-        policy = RLlibWatchPolicy(policy)
-    rows = evaluate_watch(
-        args.scenes,
-        args.watchers,
-        policy=policy,
-        episodes=args.episodes,
-        seed=args.seed,
-        env_kwargs=args.env_kwargs,
-        backend=args.backend,
-        address=args.address,
-    )
+    try:
+        if args.json:
+            check_writable_file(args.json, what="--json")
+        policy: Any = args.policy
+        if policy not in ("oracle", "random"):
+            policy = RLlibWatchPolicy(policy)  # a relative checkpoint path is made absolute
+        rows = evaluate_watch(
+            args.scenes,
+            args.watchers,
+            policy=policy,
+            episodes=args.episodes,
+            seed=args.seed,
+            env_kwargs=args.env_kwargs,
+            backend=args.backend,
+            address=args.address,
+        )
+    except ImportError as err:
+        msg = missing_extra_message(ap.prog, err)
+        if msg is None:
+            raise
+        print(msg, file=sys.stderr)
+        return 2
+    except (ValueError, KeyError, OSError) as err:
+        print(f"{ap.prog}: error: {err}", file=sys.stderr)
+        return 2
     print(format_rows(rows))
     print(f"({args.backend} backend, {rows[0]['wall_s_total']:.1f} s)")
     if args.json:

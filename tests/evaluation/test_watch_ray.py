@@ -57,11 +57,13 @@ def _rllib_shared_policy_smoke(tmp_path):
     """``sensorplan train --backend rllib --address ADDR`` attaches to the running Ray
     instance (the existing-cluster path), trains 2 tiny iterations and checkpoints."""
     import json
+    import os
     import subprocess
     import sys
 
     import yaml
 
+    from agents.evaluation.watch import main as watch_main
     from agents.evaluation.watch import run_watch_episodes
     from agents.learning.rllib_train import RLlibWatchPolicy, load_config
 
@@ -94,9 +96,18 @@ def _rllib_shared_policy_smoke(tmp_path):
     assert len(progress) == 2 and progress[-1]["env_steps"] >= 240
     saved = yaml.safe_load((out / "config.yaml").read_text())
     assert saved["address"] == address and saved["seed"] == 0
-    res = {"checkpoint": str(out / "checkpoint")}
-    policy = RLlibWatchPolicy(res["checkpoint"])
-    ep = run_watch_episodes(cfg["env"], policy, [5])
+    cwd = os.getcwd()
+    os.chdir(tmp_path)
+    try:  # a relative checkpoint path, as a user types it (pyarrow once read it as a URI)
+        policy = RLlibWatchPolicy("run/checkpoint")
+        ep = run_watch_episodes(cfg["env"], policy, [5])
+        rc = watch_main(
+            ["--scenes", "edr", "--watchers", "2", "--episodes", "1",
+             "--policy", "run/checkpoint", "--env-kwargs", json.dumps(cfg["env"])]
+        )  # fmt: skip
+    finally:
+        os.chdir(cwd)
+    assert rc == 0
     assert ep["seed"] == [5] and 0.0 <= ep["visible"][0] <= 1.0
     from sensorplan_gym import watch_v0
 
