@@ -72,7 +72,8 @@ from ..core.observations import make_observation
 from ..core.pool import FixedScene, shared_pool
 from ..core.rendering import HumanViewer, Renderer
 from ..core.sensor import NOISE_BOUND, RangeSensor
-from ..core.sim import BLOCK, BatchSim
+from ..core import fused
+from ..core.sim import BatchSim
 from ..core.world import World, WorldConfig, get_world, load_scene
 
 __all__ = ["SPEED_LIMITS", "RobotBatch", "SensorPlanBatch", "SensorPlanEnv"]
@@ -240,6 +241,9 @@ class SensorPlanBatch(BatchSim):
             if v and (obs_type != "vector" or self.obs_kind != "robot"):
                 raise ValueError(f"{name}=True needs obs_type='vector' in Navigate or Recognize")
         self.map_ranges = map_ranges or map_evidence  # the sim computes the map's ranges
+        self.params[fused.P_MAP] = self.map_ranges
+        self.params[fused.P_OBS_MAP] = map_ranges
+        self.params[fused.P_MAX_STEPS] = self.max_steps
         self.obs_type = obs_type
         self.obs = make_observation(
             self.obs_kind,
@@ -254,7 +258,6 @@ class SensorPlanBatch(BatchSim):
         self.actions = make_actions(action_type, self.action_task, self.action_dim, **action_kw)
         self.action_type = action_type
         self.single_action_space = self.actions.space
-        self.elapsed = np.zeros(self.n, dtype=np.int64)
         self.random = isinstance(scene, str) and scene == "random"
         if not isinstance(min_start_distance, (int, float)) or not 0 <= min_start_distance < 1:
             raise ValueError(f"min_start_distance must be in [0, 1), got {min_start_distance!r}")
@@ -392,6 +395,57 @@ class RobotBatch(SensorPlanBatch):
         self.dist = np.zeros(n)  # distance to the region at the last step (shaping)
         self.shaping = getattr(self, "shaping", 0.0)
         super().__init__(n, scene, **kwargs)
+        self.params[fused.P_MAX_TURN] = self.max_turn
+        self.params[fused.P_DISC] = speed_limit == "disc"
+        self.params[fused.P_SHAPING] = self.shaping
+        self.params[fused.P_STEP_COST] = getattr(self, "step_cost", 0.0)
+
+    @property
+    def compiled_step(self) -> bool:
+        """Whether :meth:`step_envs` runs the fused compiled kernel (numba installed, a
+        point robot); else the numpy path (bitwise the same answers)."""
+        return self.fused and self.robot_radius == 0.0
+
+    def _step_compiled(self, act: np.ndarray, idx: np.ndarray, task: int):
+        """:func:`.fused.robot_step` of rows ``idx``: ``(reward (k,), flags (5, k), dist
+        (k,))`` with flags terminated, truncated, recognizing, in region, aim ok."""
+        self._refill(idx)
+        b = self._kbuf
+        fused.robot_step(
+            task,
+            idx,
+            np.ascontiguousarray(act, dtype=np.float64),
+            self.params,
+            self.P,
+            self.C,
+            self.stochastic,
+            self.aim_trivial,
+            self.OFF,
+            self.segs.data,
+            self.static_segs.data,
+            self.region_xy,
+            self.region_segs.data,
+            self.hulls,
+            self.centers,
+            self._U,
+            self._Z,
+            self._ptr,
+            self.scan_dist,
+            self.scan_normal,
+            self.scan_hit,
+            self.scan_ang,
+            self.map_dist,
+            self.has_scan,
+            self.dist,
+            self.I8,
+            self.collided,
+            b.reward,
+            b.flags,
+            b.dist,
+        )
+        self._note_used(idx)
+        k = len(idx)
+        return b.reward[:k].copy(), b.flags[:, :k].copy(), b.dist[:k].copy()
 
     def load_world(self, i: int, world: World, max_speed: float | None = None) -> None:
         super().load_world(i, world, self._max_speed_cfg)
@@ -500,7 +554,7 @@ class SensorPlanEnv(gym.Env):
     @np_random.setter
     def np_random(self, value: np.random.Generator) -> None:
         self.batch.rngs[0] = value
-        self.batch._ptr[0] = BLOCK
+        self.batch.drop_block(0)
 
     @property
     def world(self) -> World:

@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..core import fused
 from .base import RobotBatch, SensorPlanEnv
 
 __all__ = ["NavigateBatch", "NavigateEnv"]
@@ -47,6 +48,7 @@ class NavigateBatch(RobotBatch):
     """Navigate-v0 over N sub-environments (see the module docstring)."""
 
     obs_kind = "robot"
+    I8_NAMES = ("elapsed", "success")
 
     def __init__(
         self,
@@ -61,8 +63,8 @@ class NavigateBatch(RobotBatch):
         self.step_cost = float(step_cost)
         self.success_bonus = float(success_bonus)
         self.shaping = float(shaping)
-        self.success = np.zeros(n, dtype=bool)
         super().__init__(n, scene, **kwargs)
+        self.params[fused.P_SUCCESS_BONUS] = self.success_bonus
 
     def _reset_one(self, i: int, options: dict) -> None:
         self._start_from_options(i, options)
@@ -87,6 +89,9 @@ class NavigateBatch(RobotBatch):
         }
 
     def step_envs(self, act: np.ndarray, idx: np.ndarray):
+        if self.compiled_step:
+            reward, f, dist = self._step_compiled(act, idx, fused.NAVIGATE)
+            return reward, f[2], f[1], self._cols(idx, f[2], dist)
         self.elapsed[idx] += 1
         self.move(act, idx)
         rec, _, _, dist = self.query(idx)

@@ -48,6 +48,7 @@ from typing import Any
 import numpy as np
 import shapely
 
+from ..core import fused
 from ..core.segments import SegmentRows, pad_segments, point_segment_distance, segment_normals
 from .base import RobotBatch, SensorPlanEnv
 
@@ -63,6 +64,9 @@ class RecognizeBatch(RobotBatch):
     obs_kind = "robot"
     action_dim = 4
     action_task = "recognize"
+    # side: _G or _H, where the hidden target is; hold: consecutive steps pointing at one
+    # label; pointing: that label; declared: the declared label (_NONE: none yet)
+    I8_NAMES = ("elapsed", "side", "hold", "pointing", "declared")
 
     def __init__(
         self,
@@ -81,13 +85,10 @@ class RecognizeBatch(RobotBatch):
         self.step_cost = float(step_cost)
         self.shaping = float(shaping)
         self.declare_hold = int(declare_hold)
-        self.hold = np.zeros(n, dtype=np.int64)  # consecutive steps pointing at one label
-        self.pointing = np.zeros(n, dtype=np.int8)
-        self.side = np.zeros(n, dtype=np.int8)  # _G or _H: where the hidden target is
-        self.declared = np.zeros(n, dtype=np.int8)
         self.target_polys: list[np.ndarray | None] = [None] * n
         self.tsegs = SegmentRows(n)
         super().__init__(n, scene, **kwargs)
+        self.params[fused.P_DECLARE_HOLD] = self.declare_hold
 
     def _place_target(self, i: int) -> None:
         """Hide the target in G or H (uniformly) and add its edges to row ``i``'s segments."""
@@ -141,8 +142,8 @@ class RecognizeBatch(RobotBatch):
     def reset_info(self, idx: np.ndarray) -> dict:
         return self._cols(idx, np.zeros(len(idx), dtype=bool))
 
-    def _cols(self, idx: np.ndarray, ended: np.ndarray) -> dict:
-        rec, _, _, dist = self.query(idx)
+    def _cols(self, idx: np.ndarray, ended: np.ndarray, q=None) -> dict:
+        rec, dist = (self.query(idx)[::3]) if q is None else q
         dec = self.declared[idx]
         return {
             "is_success": ((dec != _NONE) & (dec == self.side[idx]), None),
@@ -155,6 +156,9 @@ class RecognizeBatch(RobotBatch):
         }
 
     def step_envs(self, act: np.ndarray, idx: np.ndarray):
+        if self.compiled_step:
+            reward, f, dist = self._step_compiled(act, idx, fused.RECOGNIZE)
+            return reward, f[0], f[1], self._cols(idx, f[0] | f[1], (f[2], dist))
         self.elapsed[idx] += 1
         self.move(act, idx)
         d = act[:, 3]
