@@ -88,7 +88,9 @@ def _py_orient_exact(p1x, p1y, p2x, p2y, qx, qy) -> int:
 
 
 if HAVE_NUMBA:  # pragma: no cover - exercised when numba is installed
-    njit = numba.njit(cache=True, nogil=True)
+    # error_model="numpy": a division by zero gives inf/nan (never raised: every one is
+    # guarded as in the numpy code) and leaves the loops free of checks, so they vectorise
+    njit = numba.njit(cache=True, nogil=True, error_model="numpy")
 
     # ---- exact predicates ----------------------------------------------------------------
     @njit
@@ -222,63 +224,76 @@ if HAVE_NUMBA:  # pragma: no cover - exercised when numba is installed
 
     # ---- mechanics of one row --------------------------------------------------------------
     @njit
-    def _sweep_point(px, py, dx, dy, S, r, skin):
+    def _sweep_point(px, py, dx, dy, S, r, skin, tt):
         """:func:`.kernels.point_sweep` for one motion against row ``r`` of ``S``; 1 when
-        not moving (as :func:`.collision.sweep_batch`)."""
+        not moving (as :func:`.collision.sweep_batch`).  ``tt (M,)``: scratch (the first
+        loop runs on SIMD lanes; the second keeps the first segment of least ``t``)."""
         if dx == 0.0 and dy == 0.0:
             return 1.0
+        M = S.shape[2]
+        for q in range(M):
+            ax = S[0, r, q] - px
+            ay = S[1, r, q] - py
+            den = dx * S[3, r, q] - dy * S[2, r, q]
+            inv = 1.0 / den if den != 0.0 else np.inf
+            t = (ax * S[3, r, q] - ay * S[2, r, q]) * inv
+            u = (ax * dy - ay * dx) * inv
+            ok = (u >= 0.0) & (u <= 1.0) & (t >= 0.0)
+            tt[q] = t if ok else np.inf
         best = np.inf
         bi = 0
-        for s in range(S.shape[2]):
-            ax = S[0, r, s] - px
-            ay = S[1, r, s] - py
-            den = dx * S[3, r, s] - dy * S[2, r, s]
-            inv = 1.0 / den if den != 0.0 else np.inf
-            t = (ax * S[3, r, s] - ay * S[2, r, s]) * inv
-            u = (ax * dy - ay * dx) * inv
-            if u >= 0.0 and u <= 1.0 and t >= 0.0 and t < best:
-                best = t
-                bi = s
+        for q in range(M):
+            if tt[q] < best:
+                best = tt[q]
+                bi = q
         if best <= 1.0:
             rate = max(abs(S[4, r, bi] * dx + S[5, r, bi] * dy), 1e-300)
             return max(0.0, best - skin / rate)
         return 1.0
 
     @njit
-    def _cast_row(ox, oy, c, s, OFF, S, r, reach, front, dist, nrm, hit, i):
+    def _cast_row(ox, oy, c, s, OFF, S, r, reach, ddx, ddy, best, bi, dist, nrm, hit, i):
         """:func:`.kernels.cast` (culled) of row ``i``'s fan from ``(ox, oy)`` turned by
         ``(c, s) = (cos, sin)`` of the aim against row ``r`` of ``S``; writes ``dist[i]``,
-        ``nrm[i]`` (or only ``dist`` when ``nrm`` is empty) and ``hit[i]``."""
-        nf = 0
+        ``nrm[i]`` and ``hit[i]`` (only ``dist`` when ``hit`` is empty).  ``ddx, ddy, best,
+        bi`` ``(B,)``: scratch.  Segments outside, beams inside: the inner loop runs on SIMD lanes, and
+        each beam still keeps the first segment of least distance."""
+        B = OFF.shape[2]
+        for j in range(B):
+            ddx[j] = OFF[0, r, j] * c - OFF[1, r, j] * s
+            ddy[j] = OFF[1, r, j] * c + OFF[0, r, j] * s
+            best[j] = np.inf
+            bi[j] = 0.0
         for q in range(S.shape[2]):
-            if S[4, r, q] * (ox - S[0, r, q]) + S[5, r, q] * (oy - S[1, r, q]) > 0.0:
-                front[nf] = q
-                nf += 1
-        for j in range(OFF.shape[2]):
-            ddx = OFF[0, r, j] * c - OFF[1, r, j] * s
-            ddy = OFF[1, r, j] * c + OFF[0, r, j] * s
-            best = np.inf
-            bi = 0
-            for f in range(nf):
-                q = front[f]
-                ax = S[0, r, q] - ox
-                ay = S[1, r, q] - oy
-                den = ddx * S[3, r, q] - ddy * S[2, r, q]
+            x0 = S[0, r, q]
+            y0 = S[1, r, q]
+            if not (S[4, r, q] * (ox - x0) + S[5, r, q] * (oy - y0) > 0.0):
+                continue  # faces away from the origin (culled)
+            ex = S[2, r, q]
+            ey = S[3, r, q]
+            ax = x0 - ox
+            ay = y0 - oy
+            tn = ax * ey - ay * ex
+            fq = float(q)
+            for j in range(B):
+                den = ddx[j] * ey - ddy[j] * ex
                 inv = 1.0 / den if den != 0.0 else np.inf
-                t = (ax * S[3, r, q] - ay * S[2, r, q]) * inv
-                u = (ax * ddy - ay * ddx) * inv
-                if u >= 0.0 and u <= 1.0 and t >= 0.0 and t < best:
-                    best = t
-                    bi = q
-            h = best <= reach
-            dist[i, j] = best if h else reach
+                t = tn * inv
+                u = (ax * ddy[j] - ay * ddx[j]) * inv
+                ok = (u >= 0.0) & (u <= 1.0) & (t >= 0.0) & (t < best[j])
+                best[j] = t if ok else best[j]
+                bi[j] = fq if ok else bi[j]
+        for j in range(B):
+            h = best[j] <= reach
+            dist[i, j] = best[j] if h else reach
             if hit.shape[0] == 0:
                 continue
             hit[i, j] = h
             if h:
-                px = S[4, r, bi]
-                py = S[5, r, bi]
-                side = -(px * (S[0, r, bi] - ox) + py * (S[1, r, bi] - oy))
+                q = int(bi[j])
+                px = S[4, r, q]
+                py = S[5, r, q]
+                side = -(px * (S[0, r, q] - ox) + py * (S[1, r, q] - oy))
                 sg = 1.0 if side > 0 else (-1.0 if side < 0 else 0.0)
                 nrm[i, j, 0] = px * sg
                 nrm[i, j, 1] = py * sg
@@ -387,7 +402,7 @@ if HAVE_NUMBA:  # pragma: no cover - exercised when numba is installed
             dist[k] = d
 
     @njit
-    def _sense_row(i, P, C, stoch, noise, OFF, S, U, Z, ptr, sd, sn, sh, sa, front):
+    def _sense_row(i, P, C, stoch, noise, OFF, S, U, Z, ptr, sd, sn, sh, sa, W):
         """:meth:`BatchSim.sense` of row ``i`` (the pre-drawn block already refilled)."""
         x = P[0, i]
         y = P[1, i]
@@ -402,7 +417,7 @@ if HAVE_NUMBA:  # pragma: no cover - exercised when numba is installed
             ddx = rr * math.cos(phi)
             ddy = rr * math.sin(phi)
             if ep > 0:
-                t = _sweep_point(x, y, ddx, ddy, S, i, C[2, i])
+                t = _sweep_point(x, y, ddx, ddy, S, i, C[2, i], W[4])
                 x = x + t * ddx
                 y = y + t * ddy
             if ea > 0:
@@ -410,7 +425,7 @@ if HAVE_NUMBA:  # pragma: no cover - exercised when numba is installed
         c = math.cos(psi)
         s = math.sin(psi)
         reach = C[1, i]
-        _cast_row(x, y, c, s, OFF, S, i, reach, front, sd, sn, sh, i)
+        _cast_row(x, y, c, s, OFF, S, i, reach, W[0], W[1], W[2], W[3], sd, sn, sh, i)
         B = OFF.shape[2]
         if stoch[i] and noise > 0:
             p = ptr[i] - 1
@@ -427,10 +442,10 @@ if HAVE_NUMBA:  # pragma: no cover - exercised when numba is installed
         P[5, i] = psi
 
     @njit
-    def _map_row(i, P, C, OFF, SS, md, front, nohit, nonrm):
+    def _map_row(i, P, C, OFF, SS, md, W, nohit, nonrm):
         c = math.cos(P[2, i])
         s = math.sin(P[2, i])
-        _cast_row(P[0, i], P[1, i], c, s, OFF, SS, i, C[1, i], front, md, nonrm, nohit, i)
+        _cast_row(P[0, i], P[1, i], c, s, OFF, SS, i, C[1, i], W[0], W[1], W[2], W[3], md, nonrm, nohit, i)
 
     @njit
     def _obs_row(i, P, K, sd, sn, md, use_map, out, k):
@@ -462,14 +477,15 @@ if HAVE_NUMBA:  # pragma: no cover - exercised when numba is installed
     @njit
     def sense_kernel(idx, P, C, stoch, prm, OFF, S, SS, U, Z, ptr, sd, sn, sh, sa, md, has):
         """:meth:`BatchSim.sense` of rows ``idx``."""
-        front = np.empty(max(S.shape[2], SS.shape[2]), dtype=np.intp)
+        B = OFF.shape[2]
+        W = (np.empty(B), np.empty(B), np.empty(B), np.empty(B), np.empty(S.shape[2]))
         nohit = np.empty((0, 0), dtype=np.bool_)
         nonrm = np.empty((0, 0, 2))
         for k in range(idx.shape[0]):
             i = idx[k]
-            _sense_row(i, P, C, stoch, prm[P_NOISE], OFF, S, U, Z, ptr, sd, sn, sh, sa, front)
+            _sense_row(i, P, C, stoch, prm[P_NOISE], OFF, S, U, Z, ptr, sd, sn, sh, sa, W)
             if prm[P_MAP] != 0.0:
-                _map_row(i, P, C, OFF, SS, md, front, nohit, nonrm)
+                _map_row(i, P, C, OFF, SS, md, W, nohit, nonrm)
             has[i] = True
 
     @njit
@@ -521,7 +537,8 @@ if HAVE_NUMBA:  # pragma: no cover - exercised when numba is installed
         ok) and ``dist[:k]`` (distance to the region).  The observation is
         :func:`obs_kernel`'s (a separate call: resets change rows between the two)."""
         n = idx.shape[0]
-        front = np.empty(max(S.shape[2], SS.shape[2]), dtype=np.intp)
+        B = OFF.shape[2]
+        W = (np.empty(B), np.empty(B), np.empty(B), np.empty(B), np.empty(S.shape[2]))
         nohit = np.empty((0, 0), dtype=np.bool_)
         nonrm = np.empty((0, 0, 2))
         noise = prm[P_NOISE]
@@ -548,15 +565,15 @@ if HAVE_NUMBA:  # pragma: no cover - exercised when numba is installed
             v = C[7, i]
             dx = v * (c * a0 - s * a1)
             dy = v * (s * a0 + c * a1)
-            t = _sweep_point(x, y, dx, dy, S, i, C[2, i])
+            t = _sweep_point(x, y, dx, dy, S, i, C[2, i], W[4])
             P[0, i] = x + t * dx
             P[1, i] = y + t * dy
             P[2, i] = (psi + max_turn * act[k, 2] + PI) % TWO_PI - PI
             col[i] = t < 1.0
             # sense
-            _sense_row(i, P, C, stoch, noise, OFF, S, U, Z, ptr, sd, sn, sh, sa, front)
+            _sense_row(i, P, C, stoch, noise, OFF, S, U, Z, ptr, sd, sn, sh, sa, W)
             if use_map:
-                _map_row(i, P, C, OFF, SS, md, front, nohit, nonrm)
+                _map_row(i, P, C, OFF, SS, md, W, nohit, nonrm)
             has[i] = True
             # query
             ins, aim, d = _query_row(P[0, i], P[1, i], P[2, i], i, C, atriv, R, RS, hulls, centers)
