@@ -222,6 +222,18 @@ if HAVE_NUMBA:  # pragma: no cover - exercised when numba is installed
         for k in range(idx.shape[0]):
             out[k] = point_in_region(x[k], y[k], R, idx[k])
 
+    @njit
+    def clip_unit(a):
+        """Clip ``a`` to [-1, 1] in place (as ``np.clip``); ``False`` (``a`` untouched) when
+        it holds a NaN or an infinity."""
+        f = a.ravel()
+        for k in range(f.shape[0]):
+            if not math.isfinite(f[k]):
+                return False
+        for k in range(f.shape[0]):
+            f[k] = min(max(f[k], -1.0), 1.0)
+        return True
+
     # ---- mechanics of one row --------------------------------------------------------------
     @njit
     def _sweep_point(px, py, dx, dy, S, r, skin, tt):
@@ -476,17 +488,21 @@ if HAVE_NUMBA:  # pragma: no cover - exercised when numba is installed
 
     @njit
     def sense_kernel(idx, P, C, stoch, prm, OFF, S, SS, U, Z, ptr, sd, sn, sh, sa, md, has):
-        """:meth:`BatchSim.sense` of rows ``idx``."""
+        """:meth:`BatchSim.sense` of rows ``idx``; returns how many used up their pre-drawn
+        block."""
         B = OFF.shape[2]
         W = (np.empty(B), np.empty(B), np.empty(B), np.empty(B), np.empty(S.shape[2]))
         nohit = np.empty((0, 0), dtype=np.bool_)
         nonrm = np.empty((0, 0, 2))
+        used = 0
         for k in range(idx.shape[0]):
             i = idx[k]
             _sense_row(i, P, C, stoch, prm[P_NOISE], OFF, S, U, Z, ptr, sd, sn, sh, sa, W)
             if prm[P_MAP] != 0.0:
                 _map_row(i, P, C, OFF, SS, md, W, nohit, nonrm)
             has[i] = True
+            used += stoch[i] and ptr[i] >= U.shape[1]
+        return used
 
     @njit
     def obs_kernel(idx, P, K, sd, sn, md, prm, out):
@@ -534,7 +550,8 @@ if HAVE_NUMBA:  # pragma: no cover - exercised when numba is installed
         last step (shaping); ``I8 (5, N)`` int64 task state (elapsed
         steps, success / side, hold, pointing, declared); ``col (N,)`` collided.  Writes
         ``reward[:k]``, ``flags[:, :k]`` (terminated, truncated, recognizing, in region, aim
-        ok) and ``dist[:k]`` (distance to the region).  The observation is
+        ok) and ``dist[:k]`` (distance to the region).  Returns how many rows used up their
+        pre-drawn block.  The observation is
         :func:`obs_kernel`'s (a separate call: resets change rows between the two)."""
         n = idx.shape[0]
         B = OFF.shape[2]
@@ -547,6 +564,7 @@ if HAVE_NUMBA:  # pragma: no cover - exercised when numba is installed
         shaping = prm[P_SHAPING]
         max_steps = prm[P_MAX_STEPS]
         use_map = prm[P_MAP] != 0.0
+        used = 0
         for k in range(n):
             i = idx[k]
             I8[0, i] += 1
@@ -620,7 +638,8 @@ if HAVE_NUMBA:  # pragma: no cover - exercised when numba is installed
             reward[k] = r
             flags[0, k] = term
             flags[1, k] = trunc
+            used += stoch[i] and ptr[i] >= U.shape[1]
+        return used
 
 else:  # pragma: no cover - without numba
-    orient_sign = None
-    point_in_region = None
+    orient_sign = point_in_region = clip_unit = None

@@ -111,6 +111,7 @@ class BatchSim:
         self.fused = fused.FUSED
         self._one_world = False
         self._kbuf = _Buffers(N)
+        self._kargs: tuple | None = None  # the compiled step's arguments (tasks build them)
 
     #: names of the rows of ``I8`` (tasks extend it; at most 5)
     I8_NAMES: tuple[str, ...] = ("elapsed",)
@@ -183,6 +184,7 @@ class BatchSim:
         if self.worlds[i] is world:
             return
         self.worlds[i] = world
+        self._kargs = None  # arrays may grow
         r = world.batch_rows()
         self.segs.set_row(i, r["segs"])
         self.static_segs.set_row(i, r["segs"])
@@ -238,6 +240,8 @@ class BatchSim:
 
     def set_segments(self, i: int, rows: np.ndarray) -> None:
         """Row ``i`` of the sensed/collided segments := ``rows`` ``(6, k)``."""
+        if rows.shape[1] > self.segs.m:
+            self._kargs = None  # the rows grow
         self.segs.set_row(i, rows)
 
     # ---- mechanics --------------------------------------------------------------------
@@ -305,7 +309,7 @@ class BatchSim:
         turned uniformly within ``eps_aim``), with range noise."""
         if self.fused:
             self._refill(idx)
-            fused.sense_kernel(
+            used = fused.sense_kernel(
                 idx,
                 self.P,
                 self.C,
@@ -324,7 +328,8 @@ class BatchSim:
                 self.map_dist,
                 self.has_scan,
             )
-            self._note_used(idx)
+            if used:
+                self._note_used(idx)
             return
         self._sense_numpy(idx)
 
@@ -483,6 +488,7 @@ class BatchSim:
 
         self.__dict__.update(state)
         self._views()  # pickling does not keep views
+        self._kargs = None
         self.offsets = self.OFF[2]
         for g in (*self.regions, *self.spaces):
             if g is not None:

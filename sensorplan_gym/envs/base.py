@@ -409,12 +409,23 @@ class RobotBatch(SensorPlanBatch):
     def _step_compiled(self, act: np.ndarray, idx: np.ndarray, task: int):
         """:func:`.fused.robot_step` of rows ``idx``: ``(reward (k,), flags (5, k), dist
         (k,))`` with flags terminated, truncated, recognizing, in region, aim ok."""
-        self._refill(idx)
+        if self._empty:
+            self._refill(idx)
+        args = self._kargs
+        if args is None:
+            args = self._kargs = self._step_args()
+        act = np.ascontiguousarray(act, dtype=np.float64)
+        if fused.robot_step(task, idx, act, *args):
+            self._note_used(idx)
         b = self._kbuf
-        fused.robot_step(
-            task,
-            idx,
-            np.ascontiguousarray(act, dtype=np.float64),
+        k = len(idx)
+        return b.reward[:k].copy(), b.flags[:, :k].copy(), b.dist[:k].copy()
+
+    def _step_args(self) -> tuple:
+        """The arrays :func:`.fused.robot_step` reads and writes (after ``task, idx, act``);
+        rebuilt when a world or the segments change (arrays may be reallocated)."""
+        b = self._kbuf
+        return (
             self.params,
             self.P,
             self.C,
@@ -443,9 +454,6 @@ class RobotBatch(SensorPlanBatch):
             b.flags,
             b.dist,
         )
-        self._note_used(idx)
-        k = len(idx)
-        return b.reward[:k].copy(), b.flags[:, :k].copy(), b.dist[:k].copy()
 
     def load_world(self, i: int, world: World, max_speed: float | None = None) -> None:
         super().load_world(i, world, self._max_speed_cfg)
@@ -627,7 +635,13 @@ class SensorPlanEnv(gym.Env):
         out = {}
         for k, (v, m) in cols.items():
             if m is None or m[0]:
-                out[k] = _one_row(v[0])
+                x = v[0]
+                if isinstance(x, np.generic):
+                    out[k] = x.item()
+                elif isinstance(x, np.ndarray):
+                    out[k] = tuple(x.tolist()) if x.dtype.kind == "f" else x.tolist()
+                else:
+                    out[k] = x
         return out
 
     def render(self):
