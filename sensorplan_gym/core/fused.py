@@ -268,8 +268,8 @@ if HAVE_NUMBA:  # pragma: no cover - exercised when numba is installed
         """:func:`.kernels.cast` (culled) of row ``i``'s fan from ``(ox, oy)`` turned by
         ``(c, s) = (cos, sin)`` of the aim against row ``r`` of ``S``; writes ``dist[i]``,
         ``nrm[i]`` and ``hit[i]`` (only ``dist`` when ``hit`` is empty).  ``ddx, ddy, best,
-        bi`` ``(B,)``: scratch.  Segments outside, beams inside: the inner loop runs on SIMD lanes, and
-        each beam still keeps the first segment of least distance."""
+        bi`` ``(B,)``: scratch.  Segments outside, beams inside: the inner loop runs on SIMD
+        lanes, and each beam still keeps the first segment of least distance."""
         B = OFF.shape[2]
         for j in range(B):
             ddx[j] = OFF[0, r, j] * c - OFF[1, r, j] * s
@@ -457,7 +457,9 @@ if HAVE_NUMBA:  # pragma: no cover - exercised when numba is installed
     def _map_row(i, P, C, OFF, SS, md, W, nohit, nonrm):
         c = math.cos(P[2, i])
         s = math.sin(P[2, i])
-        _cast_row(P[0, i], P[1, i], c, s, OFF, SS, i, C[1, i], W[0], W[1], W[2], W[3], md, nonrm, nohit, i)
+        _cast_row(
+            P[0, i], P[1, i], c, s, OFF, SS, i, C[1, i], W[0], W[1], W[2], W[3], md, nonrm, nohit, i
+        )
 
     @njit
     def _obs_row(i, P, K, sd, sn, md, use_map, out, k):

@@ -38,7 +38,7 @@ from .collision import sweep_batch
 from .kernels import HAVE_NUMBA, cast, libm
 from .queries import aim_ok_batch, in_region_batch, region_distance_batch
 from .segments import PAD, SegmentRows
-from .sensor import add_noise, beam_offsets, cast_batch
+from .sensor import add_noise, beam_offsets
 from .world import World, field_lookup
 
 __all__ = ["BLOCK", "BatchSim"]
@@ -132,7 +132,7 @@ class BatchSim:
         self.drop_block(i)
 
     def drop_block(self, i: int) -> None:
-        """Forget sub-environment ``i``'s pre-drawn block (its generator was replaced)."""
+        """Forget sub-environment ``i``'s pre-drawn blocks (its generator was replaced)."""
         self._ptr[i] = BLOCK
         if self.stochastic[i]:
             self._empty.add(i)
@@ -142,8 +142,10 @@ class BatchSim:
         each from its own generator (what their next sensor reading needs first)."""
         if not self._empty:
             return
-        todo = self._empty.intersection(idx.tolist()) if len(idx) > 1 else (
-            {int(idx[0])} & self._empty
+        todo = (
+            self._empty.intersection(idx.tolist())
+            if len(idx) > 1
+            else ({int(idx[0])} & self._empty)
         )
         for i in sorted(todo):
             rng = self.rngs[i]

@@ -320,8 +320,9 @@ class World:
         """This world as the batched core reads it (computed once): ``segs`` ``(6, S)`` edge
         arrays (:func:`.segments.pad_segments`), ``region_segs`` ``(6, R)`` region boundary,
         ``region_xy`` ``(4, R)`` the same segments' end points (exact vertices, for the
-        compiled region test), ``hulls`` ``(2, K, 2)`` K_G and K_H padded by repeating their last vertex,
-        ``centers`` ``(2, 2)`` their vertex means, ``field`` (:meth:`clearance_field`)."""
+        compiled region test), ``hulls`` ``(2, K, 2)`` K_G and K_H padded by repeating their
+        last vertex, ``centers`` ``(2, 2)`` their vertex means, ``field``
+        (:meth:`clearance_field`)."""
         r = self._cache.get("rows")
         if r is None:
             k = max(len(h) for h in self.must_see)

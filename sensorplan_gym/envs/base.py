@@ -67,12 +67,12 @@ import gymnasium as gym
 import numpy as np
 import shapely
 
+from ..core import fused
 from ..core.actions import make_actions
 from ..core.observations import make_observation
 from ..core.pool import FixedScene, shared_pool
 from ..core.rendering import HumanViewer, Renderer
 from ..core.sensor import NOISE_BOUND, RangeSensor
-from ..core import fused
 from ..core.sim import BatchSim
 from ..core.world import World, WorldConfig, get_world, load_scene
 
@@ -298,13 +298,23 @@ class SensorPlanBatch(BatchSim):
     def reset_envs(self, idx: np.ndarray, options: dict | None = None) -> None:
         """Start new episodes in sub-environments ``idx``."""
         options = options or {}
-        for i in idx.tolist():
-            world, start = self.source.draw(self.rngs[i])
-            self.load_world(i, world)
-            self.starts[i] = start
-            self.elapsed[i] = 0
-            self._reset_one(i, options)
+        src = self.source
+        if not (
+            isinstance(src, FixedScene) and self._one_world and self.worlds[0] is src.world
+        ):  # a fixed scene is loaded in every row already, and its start never changes
+            for i in idx.tolist():
+                world, start = src.draw(self.rngs[i])
+                self.load_world(i, world)
+                self.starts[i] = start
+        self.elapsed[idx] = 0
+        self._reset_rows(idx, options)
         self._after_reset(idx)
+
+    def _reset_rows(self, idx: np.ndarray, options: dict) -> None:
+        """The task's own reset of rows ``idx`` (their worlds loaded); by default
+        :meth:`_reset_one` row by row."""
+        for i in idx.tolist():
+            self._reset_one(i, options)
 
     def _reset_one(self, i: int, options: dict) -> None:  # pragma: no cover - abstract
         raise NotImplementedError
@@ -493,6 +503,16 @@ class RobotBatch(SensorPlanBatch):
         else:
             self.set_pose(i, self.episode_start(i))
         self.collided[i] = False
+
+    def _reset_starts(self, idx: np.ndarray, options: dict) -> None:
+        """Put the robots of rows ``idx`` at their episode starts (see ``random_start`` and
+        ``options["start"]``), not collided."""
+        if options.get("start") is None and not self.random_start:
+            self.P[:3, idx] = self.starts[idx].T
+            self.collided[idx] = False
+        else:
+            for i in idx.tolist():
+                self._start_from_options(i, options)
 
     def _after_reset(self, idx: np.ndarray) -> None:
         self.sense(idx)

@@ -66,9 +66,9 @@ class NavigateBatch(RobotBatch):
         super().__init__(n, scene, **kwargs)
         self.params[fused.P_SUCCESS_BONUS] = self.success_bonus
 
-    def _reset_one(self, i: int, options: dict) -> None:
-        self._start_from_options(i, options)
-        self.success[i] = False
+    def _reset_rows(self, idx: np.ndarray, options: dict) -> None:
+        self._reset_starts(idx, options)
+        self.success[idx] = 0
 
     def _after_reset(self, idx: np.ndarray) -> None:
         super()._after_reset(idx)
