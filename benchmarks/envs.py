@@ -8,7 +8,7 @@ Writes a markdown table to ``benchmarks/results/envs.md`` (and prints it).
   resets included when an episode ends; CartPole-v1 the same way.
 * **batched**: ``gym.make_vec(id, num_envs=256, vectorization_mode="vector_entry_point")``,
   env-steps per second (256 per vector step; NEXT_STEP autoresets included); CartPole-v1's
-  own ``CartPoleVectorEnv`` with 256 envs the same way.
+  own ``CartPoleVectorEnv`` with 256 envs the same way.  Ratios to both anchors.
 * For Recognize-v0 the decide component is set to 0 ("continue") so that episodes are not
   cut to a step or two by random declarations; the declaring variant is shown too.
 * **numpy**: the batched core with ``SENSORPLAN_NO_NUMBA=1`` (the numpy fallback of the
@@ -170,14 +170,16 @@ def main(argv=None) -> None:
         f"Medians of {r} chunks; load average at the end: {os.getloadavg()[0]:.1f}.",
         "",
         f"| env (random actions) | single env steps/s | ratio to CartPole | batched x{N_BATCH} "
-        "env-steps/s | ratio | batched grid obs | batched, numpy fallback |",
-        "| --- | ---: | ---: | ---: | ---: | ---: | ---: |",
+        "env-steps/s | ratio to CartPole | ratio to CartPoleVectorEnv | batched grid obs "
+        "| batched, numpy fallback |",
+        "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |",
         f"| CartPole-v1 (anchor) | {cart:,.0f} | 1.00x | {cart_vec:,.0f} (CartPoleVectorEnv) | "
-        f"{ratio(cart_vec)} | | |",
+        f"{ratio(cart_vec)} | 1.00x | | |",
     ]
     for env_id, s, b, g, npy in rows:
         lines.append(
-            f"| {env_id} | {s:,.0f} | {ratio(s)} | {b:,.0f} | {ratio(b)} | {g:,.0f} | {npy:,.0f} |"
+            f"| {env_id} | {s:,.0f} | {ratio(s)} | {b:,.0f} | {ratio(b)} | "
+            f"{b / cart_vec:.3f}x | {g:,.0f} | {npy:,.0f} |"
         )
     lines += [
         "",

@@ -512,6 +512,34 @@ if HAVE_NUMBA:  # pragma: no cover - exercised when numba is installed
         for k in range(idx.shape[0]):
             _obs_row(idx[k], P, K, sd, sn, md, prm[P_OBS_MAP] != 0.0, out, k)
 
+    @njit
+    def placement_pose(idx, act, prm, P, C, atriv, lo, hi, R, RS, SP, hulls, centers, out):
+        """Placement's step before its reading, rows ``idx``: the commanded pose of the
+        (clipped) action (x, y linear over the bounding box, aim ``pi a``) into ``P``; ``out
+        (6, k)``: reward, recognizing, in region, aim ok, distance to the region, and
+        whether the placement is a free point (:func:`point_in_region` on the free space
+        ``SP``)."""
+        shaping = prm[P_SHAPING]
+        for k in range(idx.shape[0]):
+            i = idx[k]
+            x = lo[i, 0] + 0.5 * (act[k, 0] + 1.0) * (hi[i, 0] - lo[i, 0])
+            y = lo[i, 1] + 0.5 * (act[k, 1] + 1.0) * (hi[i, 1] - lo[i, 1])
+            psi = PI * act[k, 2]
+            ins, aim, d = _query_row(x, y, psi, i, C, atriv, R, RS, hulls, centers)
+            rec = ins and aim
+            r = 1.0 if rec else 0.0
+            if shaping != 0.0:
+                r -= shaping * d / C[0, i] if (d != np.inf and d == d) else 0.0
+            P[0, i] = x
+            P[1, i] = y
+            P[2, i] = psi
+            out[0, k] = r
+            out[1, k] = rec
+            out[2, k] = ins
+            out[3, k] = aim
+            out[4, k] = d
+            out[5, k] = point_in_region(x, y, SP, i)
+
     # ---- the fused step ----------------------------------------------------------------
     @njit
     def robot_step(

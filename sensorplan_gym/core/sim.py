@@ -89,6 +89,7 @@ class BatchSim:
         #: the exact region's boundary segments ``(4, N, S)``: start x, y, end x, y (padding
         #: at :data:`.segments.PAD`), for :func:`.fused.point_in_region`
         self.region_xy = np.full((4, N, 1), PAD)
+        self.space_xy = np.full((4, N, 1), PAD)  # the robot's free space, likewise
         self.regions = np.empty(N, dtype=object)
         self.spaces = np.empty(N, dtype=object)  # free space of the robot's centre
         self.hulls = np.zeros((N, 2, 1, 2))
@@ -191,13 +192,8 @@ class BatchSim:
         self.segs.set_row(i, r["segs"])
         self.static_segs.set_row(i, r["segs"])
         self.region_segs.set_row(i, r["region_segs"])
-        rxy = r["region_xy"]
-        k = rxy.shape[1]
-        if k > self.region_xy.shape[2]:
-            grow = np.full((4, self.n, k - self.region_xy.shape[2]), PAD)
-            self.region_xy = np.concatenate([self.region_xy, grow], axis=2)
-        self.region_xy[:, i, :k] = rxy
-        self.region_xy[:, i, k:] = PAD
+        self._set_ring_row("region_xy", i, r["region_xy"])
+        self._set_ring_row("space_xy", i, r["space_xy"])
         self.regions[i] = world.region
         self.spaces[i] = world.robot_space
         k = r["hulls"].shape[1]
@@ -239,6 +235,17 @@ class BatchSim:
             self._empty.add(i)
         self.aim_trivial[i] = world.fov >= TWO_PI - 1e-12 and math.isinf(world.max_range)
         self._one_world = all(w is world for w in self.worlds)
+
+    def _set_ring_row(self, name: str, i: int, rows: np.ndarray) -> None:
+        """Row ``i`` of the boundary array ``name`` ``(4, N, S)`` := ``rows`` ``(4, k)``,
+        padded with :data:`.segments.PAD` (grown when ``k > S``)."""
+        a = getattr(self, name)
+        k = rows.shape[1]
+        if k > a.shape[2]:
+            a = np.concatenate([a, np.full((4, self.n, k - a.shape[2]), PAD)], axis=2)
+            setattr(self, name, a)
+        a[:, i, :k] = rows
+        a[:, i, k:] = PAD
 
     def set_segments(self, i: int, rows: np.ndarray) -> None:
         """Row ``i`` of the sensed/collided segments := ``rows`` ``(6, k)``."""
@@ -454,6 +461,12 @@ class BatchSim:
 
     def in_free_space(self, idx: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
         """``(k,)`` bool: ``(x, y)`` is a free position of sub-environment ``idx``'s robot."""
+        if self.fused:
+            out = np.empty(len(idx), dtype=bool)
+            xs = np.ascontiguousarray(x, dtype=np.float64)
+            ys = np.ascontiguousarray(y, dtype=np.float64)
+            fused.region_test(xs, ys, self.space_xy, idx, out)
+            return out
         spaces = self.spaces[self.sel(idx)]
         if self._one_world and len(spaces) > 1:
             return in_region_batch(spaces[0], x, y)

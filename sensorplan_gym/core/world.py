@@ -320,7 +320,8 @@ class World:
         """This world as the batched core reads it (computed once): ``segs`` ``(6, S)`` edge
         arrays (:func:`.segments.pad_segments`), ``region_segs`` ``(6, R)`` region boundary,
         ``region_xy`` ``(4, R)`` the same segments' end points (exact vertices, for the
-        compiled region test), ``hulls`` ``(2, K, 2)`` K_G and K_H padded by repeating their
+        compiled region test), ``space_xy`` ``(4, F)`` the robot's free space likewise,
+        ``hulls`` ``(2, K, 2)`` K_G and K_H padded by repeating their
         last vertex, ``centers`` ``(2, 2)`` their vertex means, ``field``
         (:meth:`clearance_field`)."""
         r = self._cache.get("rows")
@@ -335,6 +336,9 @@ class World:
                     self.region_segs, segment_normals(self.region_segs), self.region_segs.shape[0]
                 ),
                 "region_xy": np.ascontiguousarray(self.region_segs.T, dtype=np.float64),
+                "space_xy": np.ascontiguousarray(
+                    boundary_segments(self.robot_space).T, dtype=np.float64
+                ),
                 "hulls": hulls,
                 "centers": np.stack([h.mean(axis=0) for h in self.must_see]),
                 "field": self.clearance_field(),

@@ -35,6 +35,7 @@ from typing import Any
 
 import numpy as np
 
+from ..core import fused
 from .base import SensorPlanBatch, SensorPlanEnv
 
 __all__ = ["PlacementBatch", "PlacementEnv"]
@@ -52,6 +53,7 @@ class PlacementBatch(SensorPlanBatch):
         self.shaping = float(shaping)
         self.placed = np.zeros(n, dtype=bool)
         super().__init__(n, scene, **kwargs)
+        self.params[fused.P_SHAPING] = self.shaping
 
     def _has_pose(self, i: int) -> bool:
         return bool(self.placed[i])
@@ -93,6 +95,8 @@ class PlacementBatch(SensorPlanBatch):
         return reward, cols
 
     def step_envs(self, act: np.ndarray, idx: np.ndarray):
+        if self.fused:
+            return self._step_compiled(act, idx)
         pose = self.action_to_pose(act, idx)
         reward, cols = self.evaluate(pose, idx)
         self.x[idx], self.y[idx], self.psi[idx] = pose.T
@@ -107,6 +111,48 @@ class PlacementBatch(SensorPlanBatch):
         cols["executed_pose"] = (executed, None)
         k = len(idx)
         return reward, np.ones(k, dtype=bool), np.zeros(k, dtype=bool), cols
+
+    def _step_compiled(self, act: np.ndarray, idx: np.ndarray):
+        """:meth:`step_envs` by :func:`.fused.placement_pose` and the compiled sensor."""
+        k = len(idx)
+        out = np.empty((6, k))
+        fused.placement_pose(
+            idx,
+            np.ascontiguousarray(act, dtype=np.float64),
+            self.params,
+            self.P,
+            self.C,
+            self.aim_trivial,
+            self.lo,
+            self.hi,
+            self.region_xy,
+            self.region_segs.data,
+            self.space_xy,
+            self.hulls,
+            self.centers,
+            out,
+        )
+        self.placed[idx] = True
+        self.has_scan[idx] = False
+        free = out[5] != 0.0
+        pose = self.P[:3, idx].T
+        if free.all():
+            self.sense(idx)
+        elif free.any():
+            self.sense(idx[free])
+        executed = self.P[3:6, idx].T
+        executed[~free] = pose[~free]
+        rec = out[1] != 0.0
+        cols = {
+            "is_success": (rec, None),
+            "recognizing": (rec.copy(), None),
+            "in_region": (out[2] != 0.0, None),
+            "aim_ok": (out[3] != 0.0, None),
+            "distance_to_region": (out[4], None),
+            "pose": (pose, None),
+            "executed_pose": (executed, None),
+        }
+        return out[0], np.ones(k, dtype=bool), np.zeros(k, dtype=bool), cols
 
 
 class PlacementEnv(SensorPlanEnv):
