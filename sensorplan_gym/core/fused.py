@@ -513,18 +513,28 @@ if HAVE_NUMBA:  # pragma: no cover - exercised when numba is installed
             _obs_row(idx[k], P, K, sd, sn, md, prm[P_OBS_MAP] != 0.0, out, k)
 
     @njit
-    def placement_pose(idx, act, prm, P, C, atriv, lo, hi, R, RS, SP, hulls, centers, out):
-        """Placement's step before its reading, rows ``idx``: the commanded pose of the
-        (clipped) action (x, y linear over the bounding box, aim ``pi a``) into ``P``; ``out
-        (6, k)``: reward, recognizing, in region, aim ok, distance to the region, and
-        whether the placement is a free point (:func:`point_in_region` on the free space
-        ``SP``)."""
+    def placement_step(
+        k0, idx, act, prm, P, C, stoch, atriv, lo, hi, R, RS, SP, hulls, centers, OFF, S,
+        U, Z, ptr, sd, sn, sh, sa, has, placed, res,
+    ):  # fmt: skip
+        """Placement's step of rows ``idx[k0:]``: the commanded pose of the (clipped)
+        action (x, y linear over the bounding box, aim ``pi a``) into ``P``, the query, and
+        the sensor reading from it when the placement is a free point (:func:`point_in_region`
+        on the free space ``SP``).  ``res (12, k)``: reward, recognizing, in region, aim ok,
+        distance to the region, free, the commanded pose, the executed pose.  Returns
+        ``len(idx)``, or the position of the first row whose reading needs a new block of
+        pre-drawn numbers (refill it and call again from there)."""
         shaping = prm[P_SHAPING]
-        for k in range(idx.shape[0]):
+        B = OFF.shape[2]
+        W = (np.empty(B), np.empty(B), np.empty(B), np.empty(B), np.empty(S.shape[2]))
+        for k in range(k0, idx.shape[0]):
             i = idx[k]
             x = lo[i, 0] + 0.5 * (act[k, 0] + 1.0) * (hi[i, 0] - lo[i, 0])
             y = lo[i, 1] + 0.5 * (act[k, 1] + 1.0) * (hi[i, 1] - lo[i, 1])
             psi = PI * act[k, 2]
+            free = point_in_region(x, y, SP, i)
+            if free and stoch[i] and ptr[i] >= U.shape[1]:
+                return k
             ins, aim, d = _query_row(x, y, psi, i, C, atriv, R, RS, hulls, centers)
             rec = ins and aim
             r = 1.0 if rec else 0.0
@@ -533,12 +543,28 @@ if HAVE_NUMBA:  # pragma: no cover - exercised when numba is installed
             P[0, i] = x
             P[1, i] = y
             P[2, i] = psi
-            out[0, k] = r
-            out[1, k] = rec
-            out[2, k] = ins
-            out[3, k] = aim
-            out[4, k] = d
-            out[5, k] = point_in_region(x, y, SP, i)
+            placed[i] = True
+            has[i] = False
+            res[0, k] = r
+            res[1, k] = rec
+            res[2, k] = ins
+            res[3, k] = aim
+            res[4, k] = d
+            res[5, k] = free
+            res[6, k] = x
+            res[7, k] = y
+            res[8, k] = psi
+            if free:
+                _sense_row(i, P, C, stoch, prm[P_NOISE], OFF, S, U, Z, ptr, sd, sn, sh, sa, W)
+                has[i] = True
+                res[9, k] = P[3, i]
+                res[10, k] = P[4, i]
+                res[11, k] = P[5, i]
+            else:
+                res[9, k] = x
+                res[10, k] = y
+                res[11, k] = psi
+        return idx.shape[0]
 
     # ---- the fused step ----------------------------------------------------------------
     @njit

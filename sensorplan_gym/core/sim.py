@@ -104,6 +104,7 @@ class BatchSim:
         self.offsets = self.OFF[2]
         self.obs_consts = np.zeros((N, 10))
         self.stochastic = np.zeros(N, dtype=bool)
+        self.n_stochastic = 0  # rows whose readings draw random numbers
         self.aim_trivial = np.zeros(N, dtype=bool)
         #: float64 parameters of the compiled kernels (:data:`.fused.P_NOISE`, ...)
         self.params = np.zeros(fused.N_PARAMS)
@@ -229,7 +230,9 @@ class BatchSim:
             *world.goal_center,
             *world.failure_center,
         )
-        self.stochastic[i] = world.eps_pos > 0 or world.eps_aim > 0 or self.noise > 0
+        st = world.eps_pos > 0 or world.eps_aim > 0 or self.noise > 0
+        self.n_stochastic += int(st) - int(self.stochastic[i])
+        self.stochastic[i] = st
         self._empty.discard(i)
         if self.stochastic[i] and self._ptr[i] >= BLOCK:
             self._empty.add(i)

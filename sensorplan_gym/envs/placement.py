@@ -113,46 +113,58 @@ class PlacementBatch(SensorPlanBatch):
         return reward, np.ones(k, dtype=bool), np.zeros(k, dtype=bool), cols
 
     def _step_compiled(self, act: np.ndarray, idx: np.ndarray):
-        """:meth:`step_envs` by :func:`.fused.placement_pose` and the compiled sensor."""
+        """:meth:`step_envs` by :func:`.fused.placement_step` (one call; another after
+        each refill of a row's pre-drawn numbers)."""
         k = len(idx)
-        out = np.empty((6, k))
-        fused.placement_pose(
-            idx,
-            np.ascontiguousarray(act, dtype=np.float64),
-            self.params,
-            self.P,
-            self.C,
-            self.aim_trivial,
-            self.lo,
-            self.hi,
-            self.region_xy,
-            self.region_segs.data,
-            self.space_xy,
-            self.hulls,
-            self.centers,
-            out,
-        )
-        self.placed[idx] = True
-        self.has_scan[idx] = False
-        free = out[5] != 0.0
-        pose = self.P[:3, idx].T
-        if free.all():
-            self.sense(idx)
-        elif free.any():
-            self.sense(idx[free])
-        executed = self.P[3:6, idx].T
-        executed[~free] = pose[~free]
-        rec = out[1] != 0.0
+        res = np.empty((12, k))
+        act = np.ascontiguousarray(act, dtype=np.float64)
+        k0 = 0
+        while True:
+            k0 = fused.placement_step(
+                k0,
+                idx,
+                act,
+                self.params,
+                self.P,
+                self.C,
+                self.stochastic,
+                self.aim_trivial,
+                self.lo,
+                self.hi,
+                self.region_xy,
+                self.region_segs.data,
+                self.space_xy,
+                self.hulls,
+                self.centers,
+                self.OFF,
+                self.segs.data,
+                self._U,
+                self._Z,
+                self._ptr,
+                self.scan_dist,
+                self.scan_normal,
+                self.scan_hit,
+                self.scan_ang,
+                self.has_scan,
+                self.placed,
+                res,
+            )
+            if k0 == k:
+                break
+            self._refill(idx[k0 : k0 + 1])
+        if self.n_stochastic:
+            self._note_used(idx)
+        flags = res[1:4] != 0.0
         cols = {
-            "is_success": (rec, None),
-            "recognizing": (rec.copy(), None),
-            "in_region": (out[2] != 0.0, None),
-            "aim_ok": (out[3] != 0.0, None),
-            "distance_to_region": (out[4], None),
-            "pose": (pose, None),
-            "executed_pose": (executed, None),
+            "is_success": (flags[0], None),
+            "recognizing": (flags[0].copy(), None),
+            "in_region": (flags[1], None),
+            "aim_ok": (flags[2], None),
+            "distance_to_region": (res[4], None),
+            "pose": (res[6:9].T, None),
+            "executed_pose": (res[9:12].T, None),
         }
-        return out[0], np.ones(k, dtype=bool), np.zeros(k, dtype=bool), cols
+        return res[0], np.ones(k, dtype=bool), np.zeros(k, dtype=bool), cols
 
 
 class PlacementEnv(SensorPlanEnv):
