@@ -424,7 +424,8 @@ class RobotBatch(SensorPlanBatch):
         args = self._kargs
         if args is None:
             args = self._kargs = self._step_args()
-        act = np.ascontiguousarray(act, dtype=np.float64)
+        if act.dtype != np.float64 or not act.flags.c_contiguous:
+            act = np.ascontiguousarray(act, dtype=np.float64)
         if fused.robot_step(task, idx, act, *args):
             self._note_used(idx)
         b = self._kbuf

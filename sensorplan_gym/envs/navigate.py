@@ -79,12 +79,12 @@ class NavigateBatch(RobotBatch):
         return self._cols(idx, rec, dist)
 
     def _cols(self, idx, rec, dist) -> dict:
-        pose = np.stack([self.x[idx], self.y[idx], self.psi[idx]], axis=1)
+        pose = self.P[:3, idx].T
         return {
             "is_success": (rec, None),
             "recognizing": (rec, None),
             "distance_to_region": (dist, None),
-            "collided": (self.collided[idx].copy(), None),
+            "collided": (self.collided[idx], None),
             "pose": (pose, None),
         }
 

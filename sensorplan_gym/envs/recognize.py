@@ -172,8 +172,8 @@ class RecognizeBatch(RobotBatch):
             "declared": (_LABEL[dec], None),
             "recognizing": (rec, None),
             "distance_to_region": (dist, None),
-            "collided": (self.collided[idx].copy(), None),
-            "pose": (np.stack([self.x[idx], self.y[idx], self.psi[idx]], axis=1), None),
+            "collided": (self.collided[idx], None),
+            "pose": (self.P[:3, idx].T, None),
             "target_in": (_LABEL[self.side[idx]], ended),
         }
 
