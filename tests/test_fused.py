@@ -203,3 +203,34 @@ def test_numpy_fallback_without_numba_gives_the_same_episodes():
     )
     fallback = json.loads(out.stdout.strip().splitlines()[-1])
     assert fallback == [_digest(e, k, steps) for e, k in cases]
+
+
+@pytest.mark.parametrize("env_id", ["sensorplan/Navigate-v0", "sensorplan/Recognize-v0"])
+def test_sub_env_equals_single_env_on_a_scene_pool(env_id):
+    """Worlds copied from per-world snapshots (a pool of 3 scenes, many resets) give each
+    sub-environment exactly the single env's episodes (NEXT_STEP autoresets)."""
+    n = 3
+    kw = dict(scene="random", scene_pool_size=3, max_steps=25, **NOISY)
+    venv = gym.make_vec(env_id, num_envs=n, vectorization_mode="vector_entry_point", **kw)
+    singles = [gym.make(env_id, **kw) for _ in range(n)]
+    obs, _ = venv.reset(seed=4)
+    for i, e in enumerate(singles):
+        assert np.array_equal(obs[i], e.reset(seed=4 + i)[0])
+    rng = np.random.default_rng(2)
+    done = [False] * n
+    ends = 0
+    for _ in range(150):
+        a = rng.uniform(-1, 1, venv.action_space.shape).astype(np.float32)
+        if a.shape[1] == 4:
+            a[:, 3] = np.where(rng.random(n) < 0.1, np.sign(a[:, 3]), 0.0)
+        obs, rew, term, trunc, _ = venv.step(a)
+        for i, e in enumerate(singles):
+            if done[i]:
+                o, r, te, tr = (*e.reset()[:1], 0.0, False, False)
+            else:
+                o, r, te, tr, _ = e.step(a[i])
+            assert np.array_equal(o, obs[i]) and (r, te, tr) == (rew[i], term[i], trunc[i])
+            done[i] = te or tr
+            ends += done[i]
+    worlds = {id(w) for w in venv.unwrapped.batch.worlds}
+    assert ends >= 9 and len(venv.unwrapped.batch._snap.keep) >= 2 and worlds

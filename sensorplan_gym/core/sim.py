@@ -118,6 +118,11 @@ class BatchSim:
     #: names of the rows of ``I8`` (tasks extend it; at most 5)
     I8_NAMES: tuple[str, ...] = ("elapsed",)
 
+    @property
+    def _field_used(self) -> bool:
+        """Whether the drive reads the clearance fields (disc robots, or no numba)."""
+        return self.robot_radius > 0.0 or not HAVE_NUMBA
+
     def _views(self) -> None:
         for k, name in enumerate(("x", "y", "psi", "sx", "sy", "spsi")):
             setattr(self, name, self.P[k])
@@ -203,9 +208,10 @@ class BatchSim:
         hulls[i, :, k:] = r["hulls"][:, -1:]
         self.centers[i] = r["centers"]
         F, ox, oy, inv_h = r["field"]
-        fields = self._grow("fields", F.shape)
-        fields[i] = 0.0
-        fields[i, : F.shape[0], : F.shape[1]] = F
+        if self._field_used:
+            fields = self._grow("fields", F.shape)
+            fields[i] = 0.0
+            fields[i, : F.shape[0], : F.shape[1]] = F
         self.field_o[i] = (ox, oy)
         self.field_inv_h[i] = inv_h
         self.diameter[i] = world.diameter
@@ -238,6 +244,79 @@ class BatchSim:
             self._empty.add(i)
         self.aim_trivial[i] = world.fov >= TWO_PI - 1e-12 and math.isinf(world.max_range)
         self._one_world = all(w is world for w in self.worlds)
+
+    # ---- many rows at once: per-world snapshots ---------------------------------------
+    def _row_arrays(self) -> list[tuple[np.ndarray, int]]:
+        """The padded arrays :meth:`load_world` writes, with their row axis (tasks extend
+        the list)."""
+        return [
+            (self.segs.data, 1),
+            (self.static_segs.data, 1),
+            (self.region_segs.data, 1),
+            (self.region_xy, 1),
+            (self.space_xy, 1),
+            (self.hulls, 0),
+            (self.centers, 0),
+            *([(self.fields, 0)] if self._field_used else []),
+            (self.field_o, 0),
+            (self.field_inv_h, 0),
+            (self.C, 1),
+            (self.lo, 0),
+            (self.hi, 0),
+            (self.goal_c, 0),
+            (self.fail_c, 0),
+            (self.OFF, 1),
+            (self.obs_consts, 0),
+            (self.stochastic, 0),
+            (self.aim_trivial, 0),
+        ]
+
+    def load_worlds(self, rows: np.ndarray, worlds: list[World]) -> None:
+        """Load ``worlds[k]`` into row ``rows[k]`` (as :meth:`load_world`).  A world seen
+        before is copied from its snapshot -- the rows it wrote the first time -- with one
+        array operation per padded array for all such rows; the snapshots are dropped when
+        a larger world widens the arrays."""
+        cache = self.__dict__.setdefault("_snap", _Snapshots())
+        pending = [(i, w) for i, w in zip(rows.tolist(), worlds, strict=True)]
+        while True:
+            todo = [(i, w) for i, w in pending if self.worlds[i] is not w]
+            if not todo:
+                return
+            arrays = self._row_arrays()
+            cache.check(arrays)
+            missing = [(i, w) for i, w in todo if id(w) not in cache.slot]
+            if not missing:
+                break
+            seen: set[int] = set()
+            for i, w in missing:  # the first row of each new world the slow way
+                if id(w) in seen:
+                    continue
+                seen.add(id(w))
+                self.load_world(i, w)
+                arrays = self._row_arrays()
+                cache.check(arrays)  # a wider world drops every snapshot: another round
+                cache.add(w, i, arrays)
+        fast_rows = [i for i, _ in todo]
+        fast_slots = [cache.slot[id(w)] for _, w in todo]
+        for i, w in todo:
+            self.worlds[i] = w
+        r = np.array(fast_rows)
+        st = int(self.stochastic[r].sum())
+        cache.copy(r, np.array(fast_slots), arrays)
+        self._kargs = None
+        for i in fast_rows:
+            w = self.worlds[i]
+            self.regions[i] = w.region
+            self.spaces[i] = w.robot_space
+        self.n_stochastic += int(self.stochastic[r].sum()) - st
+        self._empty.difference_update(fast_rows)
+        self._empty.update(r[self.stochastic[r] & (self._ptr[r] >= BLOCK)].tolist())
+        w0 = self.worlds[0]
+        self._one_world = all(w is w0 for w in self.worlds)
+        self._rows_loaded(r)
+
+    def _rows_loaded(self, rows: np.ndarray) -> None:
+        """Task hook: rows ``rows`` got new worlds from snapshots."""
 
     def _set_ring_row(self, name: str, i: int, rows: np.ndarray) -> None:
         """Row ``i`` of the boundary array ``name`` ``(4, N, S)`` := ``rows`` ``(4, k)``,
@@ -499,7 +578,10 @@ class BatchSim:
         )
 
     def __getstate__(self) -> dict[str, Any]:
-        return self.__dict__.copy()
+        state = self.__dict__.copy()
+        state.pop("_snap", None)  # keyed by object ids: rebuilt after unpickling
+        state["_kargs"] = None
+        return state
 
     def __setstate__(self, state: dict[str, Any]) -> None:
         import shapely
@@ -514,6 +596,56 @@ class BatchSim:
 
 
 _ALL = slice(None)
+
+
+class _Snapshots:
+    """Per-world copies of the rows a world writes into the padded arrays (slot ``k`` of
+    every array holds the row of the ``k``-th world seen)."""
+
+    def __init__(self) -> None:
+        self.slot: dict[int, int] = {}
+        self.keep: list = []  # the worlds (their ids stay valid)
+        self.store: list[np.ndarray] = []
+        self.shapes: tuple | None = None
+
+    @staticmethod
+    def _shapes(arrays) -> tuple:
+        return tuple(a.shape[:ax] + a.shape[ax + 1 :] for a, ax in arrays)
+
+    def check(self, arrays) -> None:
+        """Drop every snapshot when the arrays' padded shapes changed."""
+        sh = self._shapes(arrays)
+        if sh != self.shapes:
+            self.__init__()
+            self.shapes = sh
+
+    def add(self, world, i: int, arrays) -> None:
+        k = len(self.keep)
+        if not self.store:
+            self.store = [
+                np.zeros(a.shape[:ax] + (8,) + a.shape[ax + 1 :], dtype=a.dtype) for a, ax in arrays
+            ]
+        cap = self.store[0].shape[arrays[0][1]]
+        if k == cap:
+            self.store = [
+                np.concatenate([s, np.zeros_like(s)], axis=ax)
+                for s, (_, ax) in zip(self.store, arrays, strict=True)
+            ]
+        for s, (a, ax) in zip(self.store, arrays, strict=True):
+            if ax == 0:
+                s[k] = a[i]
+            else:
+                s[:, k] = a[:, i]
+        self.slot[id(world)] = k
+        self.keep.append(world)
+
+    def copy(self, rows: np.ndarray, slots: np.ndarray, arrays) -> None:
+        """Rows ``rows`` := snapshots ``slots``."""
+        for s, (a, ax) in zip(self.store, arrays, strict=True):
+            if ax == 0:
+                a[rows] = s[slots]
+            else:
+                a[:, rows] = s[:, slots]
 
 
 class _Buffers:

@@ -302,10 +302,9 @@ class SensorPlanBatch(BatchSim):
         if not (
             isinstance(src, FixedScene) and self._one_world and self.worlds[0] is src.world
         ):  # a fixed scene is loaded in every row already, and its start never changes
-            for i in idx.tolist():
-                world, start = src.draw(self.rngs[i])
-                self.load_world(i, world)
-                self.starts[i] = start
+            drawn = [src.draw(self.rngs[i]) for i in idx.tolist()]
+            self.load_worlds(idx, [w for w, _ in drawn])
+            self.starts[idx] = [s for _, s in drawn]
         self.elapsed[idx] = 0
         self._reset_rows(idx, options)
         self._after_reset(idx)

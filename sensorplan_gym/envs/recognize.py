@@ -102,6 +102,16 @@ class RecognizeBatch(RobotBatch):
         self.tsegs.reserve(v)
         self.placed[i] = False
 
+    def _row_arrays(self) -> list[tuple[np.ndarray, int]]:
+        T = self.tt
+        return super()._row_arrays() + [
+            (a, 0)
+            for a in (T.tri, T.cum, T.ntri, T.pts, T.tgt, T.nv, T.rot, T.H, T.nh, T.trows, T.nstat)
+        ]
+
+    def _rows_loaded(self, rows: np.ndarray) -> None:
+        self.placed[rows] = False
+
     def drop_block(self, i: int) -> None:
         super().drop_block(i)
         self.tt.uptr[i] = self.tt.U.shape[1]  # the target's uniforms too
