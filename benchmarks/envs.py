@@ -156,6 +156,7 @@ def main(argv=None) -> None:
         npy = numpy_fallback(env_id, max(nv // 4, 3), r)
         rows.append((env_id, s, b, g, npy))
     rec_decl = batched_sps("sensorplan/Recognize-v0", nv, r, declare=True)
+    rec_decl_rand = batched_sps("sensorplan/Recognize-v0", nv, r, declare=True, scene="random")
     nav_rand = batched_sps("sensorplan/Navigate-v0", nv, r, scene="random")
 
     def ratio(v: float) -> str:
@@ -184,8 +185,10 @@ def main(argv=None) -> None:
     lines += [
         "",
         f"Batched Recognize-v0 with fully random actions (2/3 of the steps declare, so most "
-        f"steps are autoresets): {rec_decl:,.0f} env-steps/s ({ratio(rec_decl)}).  "
-        f'Batched Navigate-v0 on `scene="random"` (a pool of 64 scenes): {nav_rand:,.0f} '
+        f"steps are autoresets): {rec_decl:,.0f} env-steps/s ({ratio(rec_decl)}); on "
+        f'`scene="random"` (a pool of 64 scenes, a new scene at most resets): '
+        f"{rec_decl_rand:,.0f} env-steps/s ({ratio(rec_decl_rand)}).  "
+        f'Batched Navigate-v0 on `scene="random"`: {nav_rand:,.0f} '
         f"env-steps/s ({ratio(nav_rand)}).",
     ]
     if args.train:

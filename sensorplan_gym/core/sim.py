@@ -16,13 +16,27 @@ latest scans -- and the mechanics:
 The tasks (``sensorplan_gym.envs``) subclass it with their reset and reward rules; the
 single env is the batch of one and the vector env the batch of N, so both run this code.
 
+Two paths compute the same numbers: with numba (``fused = True``) :meth:`sense`,
+:meth:`query`, the observation and the tasks' whole steps are compiled kernels
+(:mod:`.fused`) over preallocated arrays -- the per-row state lives in a few stacked arrays
+(``P`` poses, ``C`` constants, ``I8`` integer task state, with the named attributes as
+views) so that one call carries it all; without numba (or ``fused = False``) the numpy
+code below runs.  Both evaluate the same expressions in the same order and use libm's
+transcendentals (:func:`.kernels.libm`), so their answers are bitwise equal.
+
+Worlds enter rows through :meth:`load_world`, or :meth:`load_worlds` for many rows at once
+(resets on scene pools): a world seen before is copied from a snapshot of the rows it wrote
+the first time, one array operation per padded array for all the resetting rows.
+
 Randomness
 ----------
 Sub-environment ``i`` draws only from its own ``numpy`` generator ``rngs[i]``: directly at its
-resets (scene, start, target) and, for the per-step sensor uncertainty and noise, through a
+resets (scene, random start), through a block of pre-drawn uniforms for hiding Recognize's
+target (:mod:`.targets`) and, for the per-step sensor uncertainty and noise, through a
 block of pre-drawn uniforms and normals refilled from that generator every
-:data:`BLOCK` steps.  A sub-environment of a batch therefore produces exactly the numbers a
-single environment seeded the same way produces.
+:data:`BLOCK` readings (just before the reading that needs it, in both paths).  A
+sub-environment of a batch therefore produces exactly the numbers a single environment
+seeded the same way produces.
 """
 
 from __future__ import annotations
