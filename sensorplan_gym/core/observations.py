@@ -226,17 +226,20 @@ def _rasters(sim: BatchSim, idx: np.ndarray, size: int) -> np.ndarray:
 class PlacementVectorObs:
     def __init__(self, n_beams: int, grid_size: int = 64) -> None:
         self.n = n_beams
+        self._key = f"placement_vec{n_beams}"
         low = np.concatenate([-np.ones(4), np.zeros(4 + 2 * n_beams)]).astype(np.float32)
         self.space = spaces.Box(low, np.ones(8 + 2 * n_beams, dtype=np.float32), dtype=np.float32)
 
     def __call__(self, sim: BatchSim, idx: np.ndarray) -> np.ndarray:
         if sim._one_world:
-            return np.tile(self.of_world(sim.worlds[0]), (len(idx), 1))
+            out = np.empty((len(idx), self.space.shape[0]), dtype=np.float32)
+            out[:] = self.of_world(sim.worlds[0])
+            return out
         return np.stack([self.of_world(sim.worlds[i]) for i in idx.tolist()])
 
     def of_world(self, world: World) -> np.ndarray:
         """The (constant) observation of one world, computed once."""
-        key = f"placement_vec{self.n}"
+        key = self._key
         cached = world._cache.get(key)
         if cached is not None:
             return cached

@@ -117,13 +117,11 @@ class PlacementBatch(SensorPlanBatch):
         each refill of a row's pre-drawn numbers)."""
         k = len(idx)
         res = np.empty((12, k))
-        act = np.ascontiguousarray(act, dtype=np.float64)
-        k0 = 0
-        while True:
-            k0 = fused.placement_step(
-                k0,
-                idx,
-                act,
+        if act.dtype != np.float64 or not act.flags.c_contiguous:
+            act = np.ascontiguousarray(act, dtype=np.float64)
+        args = self._kargs
+        if args is None:
+            args = self._kargs = (
                 self.params,
                 self.P,
                 self.C,
@@ -147,8 +145,10 @@ class PlacementBatch(SensorPlanBatch):
                 self.scan_ang,
                 self.has_scan,
                 self.placed,
-                res,
             )
+        k0 = 0
+        while True:
+            k0 = fused.placement_step(k0, idx, act, *args, res)
             if k0 == k:
                 break
             self._refill(idx[k0 : k0 + 1])
