@@ -141,9 +141,13 @@ def _episodes(env_id: str, steps: int, fused_on: bool, n: int = 3, **kw):
     rng = np.random.default_rng(5)
     out = [obs.tobytes(), repr(sorted((k, np.asarray(v).tolist()) for k, v in info.items()))]
     for _ in range(steps):
-        a = rng.uniform(-1, 1, venv.action_space.shape).astype(np.float32)
-        if a.shape[1] == 4:
-            a[:, 3] = np.where(rng.random(n) < 0.04, np.sign(a[:, 3]), 0.0)
+        if kw.get("action_type") == "discrete":
+            a = rng.integers(0, venv.single_action_space.n, n)
+            a[rng.random(n) > 0.04] %= 7  # declare now and then
+        else:
+            a = rng.uniform(-1, 1, venv.action_space.shape).astype(np.float32)
+            if a.shape[1] == 4:
+                a[:, 3] = np.where(rng.random(n) < 0.04, np.sign(a[:, 3]), 0.0)
         obs, r, te, tr, info = venv.step(a)
         out += [obs.tobytes(), r.tobytes(), te.tobytes(), tr.tobytes()]
         out.append(repr(sorted((k, np.asarray(v).tolist()) for k, v in info.items())))
@@ -159,6 +163,9 @@ CASES = [
     ("sensorplan/Recognize-v0", {"scene": "random", "scene_pool_size": 4, **NOISY}),
     ("sensorplan/Recognize-v0", {"model": "partial", "motion": "stationary"}),
     ("sensorplan/Placement-v0", {**NOISY, "fov_deg": 90}),
+    ("sensorplan/Placement-v0", {"scene": "random", "scene_pool_size": 3, **NOISY}),
+    # a disc robot: the drive stays numpy (the capsule sweep), the rest compiled
+    ("sensorplan/Recognize-v0", {"robot_radius": 0.1, **NOISY, "action_type": "discrete"}),
 ]
 
 
