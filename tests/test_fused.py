@@ -157,6 +157,7 @@ def _episodes(env_id: str, steps: int, fused_on: bool, n: int = 3, **kw):
 CASES = [
     ("sensorplan/Navigate-v0", {}),
     ("sensorplan/Navigate-v0", {**NOISY, "fov_deg": 120, "map_ranges": True}),
+    ("sensorplan/Navigate-v0", {**NOISY, "max_range": 2.5}),  # beams that hit nothing
     ("sensorplan/Navigate-v0", {"scene": "edr", "shaping": 1.0, "speed_limit": "disc"}),
     ("sensorplan/Recognize-v0", {**NOISY, "map_evidence": True, "sensor_fov": True}),
     ("sensorplan/Recognize-v0", {"motion": "rotating", "random_start": True, "shaping": 0.5}),
@@ -191,7 +192,7 @@ def _digest(env_id: str, kw: dict, steps: int) -> str:
 def test_numpy_fallback_without_numba_gives_the_same_episodes():
     """The whole package without numba (the numpy kernels, the pure-Python target
     placement) reproduces the compiled episodes bit for bit."""
-    cases = [CASES[1], CASES[3], CASES[4], CASES[7]]
+    cases = [CASES[1], CASES[2], CASES[4], CASES[5], CASES[8], CASES[10]]
     steps = 120
     code = (
         "import json, sys; from tests.test_fused import _digest; "

@@ -89,9 +89,9 @@ def cast_numpy(ox, oy, dx, dy, x0, y0, ex, ey, nx, ny, max_range, cull=False):
     rows = np.arange(len(ox))[:, None]
     r = rows if x0.shape[0] > 1 else 0
     gx, gy = nx[r, idx], ny[r, idx]
-    side = -(gx * ax[rows, idx] + gy * ay[rows, idx])
-    sgn = np.sign(side) * hit
-    return dist, hit, gx * sgn, gy * sgn
+    sgn = np.sign(-(gx * ax[rows, idx] + gy * ay[rows, idx]))
+    # +0.0 where nothing was hit (as the compiled loop writes it: bitwise, not just equal)
+    return dist, hit, np.where(hit, gx * sgn, 0.0), np.where(hit, gy * sgn, 0.0)
 
 
 def _front(ox, oy, x0, y0, nx, ny) -> np.ndarray:
