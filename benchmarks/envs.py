@@ -17,10 +17,11 @@ Writes a markdown table to ``benchmarks/results/envs.md`` (and prints it).
   (``agents/configs/ppo.yaml``, same hyperparameters) on the batched path and on SB3's
   DummyVecEnv of single envs; env steps per second of wall clock, updates included.
 
-Every figure is the median of ``--repeats`` timed chunks.  Ratios are to CartPole-v1 (single
-env, or ``CartPoleVectorEnv``) measured in the same run, chunk by chunk: an env's chunks
-alternate with the anchor's and the ratio quoted is the median of the per-pair ratios, so a
-shared, noisy machine slows both sides of each ratio alike (compare ratios, not rates).
+Every figure is the median of ``--repeats`` timed chunks (about 0.1 s each).  Ratios are to
+CartPole-v1 (single env, or ``CartPoleVectorEnv``) measured in the same run, chunk by chunk:
+an env's chunks alternate with the anchor's and the ratio quoted is the median of the
+per-pair ratios, so a shared, noisy machine slows both sides of each ratio alike (compare
+ratios, not rates).
 """
 
 from __future__ import annotations
@@ -43,6 +44,8 @@ import sensorplan_gym  # noqa: F401
 
 IDS = ["sensorplan/Placement-v0", "sensorplan/Navigate-v0", "sensorplan/Recognize-v0"]
 N_BATCH = 256
+#: the length of one timed chunk in the paired (anchor, env) measurements, seconds
+CHUNK_SECONDS = 0.1
 
 
 def _no_declare(a: np.ndarray) -> np.ndarray:
@@ -62,14 +65,15 @@ def single_runner(env_id: str, chunk: int, declare: bool = False, **kw) -> Calla
         acts = [_no_declare(a) for a in acts]
     pos = [0]
 
-    def run() -> float:
+    def run(calls: int | None = None) -> float:
+        calls = chunk if calls is None else calls
         t = time.perf_counter()
-        for _ in range(chunk):
+        for _ in range(calls):
             _, _, te, tr, _ = env.step(acts[pos[0] % len(acts)])
             pos[0] += 1
             if te or tr:
                 env.reset()
-        return chunk / (time.perf_counter() - t)
+        return calls / (time.perf_counter() - t)
 
     return run
 
@@ -96,26 +100,44 @@ def batched_runner(
         venv.step(acts[k % len(acts)])
     pos = [0]
 
-    def run() -> float:
+    def run(calls: int | None = None) -> float:
+        calls = chunk if calls is None else calls
         t = time.perf_counter()
-        for _ in range(chunk):
+        for _ in range(calls):
             venv.step(acts[pos[0] % len(acts)])
             pos[0] += 1
-        return chunk * num_envs / (time.perf_counter() - t)
+        return calls * num_envs / (time.perf_counter() - t)
 
     return run
 
 
+def _calls_for(run: Callable[..., float], seconds: float) -> int:
+    """How many calls of ``run`` take about ``seconds``."""
+    k = 1
+    while True:
+        t = time.perf_counter()
+        run(k)
+        dt = time.perf_counter() - t
+        if dt >= seconds / 4:
+            return max(1, round(k * seconds / dt))
+        k *= 4
+
+
 def paired(
-    anchor: Callable[[], float], other: Callable[[], float], repeats: int, log: list | None = None
+    anchor: Callable[..., float],
+    other: Callable[..., float],
+    repeats: int,
+    log: list | None = None,
+    seconds: float = CHUNK_SECONDS,
 ):
-    """Alternate chunks of ``anchor`` and ``other`` (so both see the same load): the
-    median rates and the median of the per-pair ratios ``other / anchor``; the anchor's
-    rates are appended to ``log``."""
+    """Alternate chunks of ``anchor`` and ``other``, each about ``seconds`` long (so both
+    see the same load): the median rates and the median of the per-pair ratios ``other /
+    anchor``; the anchor's rates are appended to ``log``."""
+    ka, ko = _calls_for(anchor, seconds), _calls_for(other, seconds)
     ra, ro = [], []
     for _ in range(repeats):
-        ra.append(anchor())
-        ro.append(other())
+        ra.append(anchor(ka))
+        ro.append(other(ko))
     if log is not None:
         log.extend(ra)
     ratios = np.array(ro) / np.array(ra)
@@ -233,8 +255,9 @@ def main(argv=None) -> None:
         f"Machine: {os.cpu_count()} cores, {platform.python_implementation()} "
         f"{platform.python_version()}, numpy {np.__version__}, gymnasium {gym.__version__}.  "
         f"Command: `python -m benchmarks.envs{' --train' if args.train else ''}`.  "
-        f"Medians of {r} chunks; every ratio is the median of {r} ratios of chunks timed "
-        f"alternately with the anchor's (the load changes alike for both); load average at "
+        f"Medians of {r} chunks of about {CHUNK_SECONDS} s; every ratio is the median of {r} "
+        f"ratios of chunks timed alternately with the anchor's (the load changes alike for "
+        f"both); load average at "
         f"the end: {os.getloadavg()[0]:.1f}.",
         "",
         f"| env (random actions) | single env steps/s | ratio to CartPole | batched x{N_BATCH} "
