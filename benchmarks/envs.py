@@ -8,7 +8,7 @@ Writes a markdown table to ``benchmarks/results/envs.md`` (and prints it).
   resets included when an episode ends; CartPole-v1 the same way.
 * **batched**: ``gym.make_vec(id, num_envs=256, vectorization_mode="vector_entry_point")``,
   env-steps per second (256 per vector step; NEXT_STEP autoresets included); CartPole-v1's
-  own ``CartPoleVectorEnv`` with 256 envs the same way.
+  own ``CartPoleVectorEnv`` with 256 envs the same way.  Ratios to both anchors.
 * For Recognize-v0 the decide component is set to 0 ("continue") so that episodes are not
   cut to a step or two by random declarations; the declaring variant is shown too.
 * **numpy**: the batched core with ``SENSORPLAN_NO_NUMBA=1`` (the numpy fallback of the
@@ -17,8 +17,11 @@ Writes a markdown table to ``benchmarks/results/envs.md`` (and prints it).
   (``agents/configs/ppo.yaml``, same hyperparameters) on the batched path and on SB3's
   DummyVecEnv of single envs; env steps per second of wall clock, updates included.
 
-Every figure is the median of ``--repeats`` timed chunks; ratios are to CartPole-v1 single
-env measured in the same run (the 2-core machine is shared and noisy: compare ratios).
+Every figure is the median of ``--repeats`` timed chunks (about 0.1 s each).  Ratios are to
+CartPole-v1 (single env, or ``CartPoleVectorEnv``) measured in the same run, chunk by chunk:
+an env's chunks alternate with the anchor's and the ratio quoted is the median of the
+per-pair ratios, so a shared, noisy machine slows both sides of each ratio alike (compare
+ratios, not rates).
 """
 
 from __future__ import annotations
@@ -31,6 +34,7 @@ import subprocess
 import sys
 import tempfile
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import gymnasium as gym
@@ -40,6 +44,8 @@ import sensorplan_gym  # noqa: F401
 
 IDS = ["sensorplan/Placement-v0", "sensorplan/Navigate-v0", "sensorplan/Recognize-v0"]
 N_BATCH = 256
+#: the length of one timed chunk in the paired (anchor, env) measurements, seconds
+CHUNK_SECONDS = 0.1
 
 
 def _no_declare(a: np.ndarray) -> np.ndarray:
@@ -48,46 +54,108 @@ def _no_declare(a: np.ndarray) -> np.ndarray:
     return a
 
 
-def single_sps(env_id: str, steps: int, repeats: int, declare: bool = False, **kw) -> float:
-    """Median steps/s of one env (resets included)."""
+def single_runner(env_id: str, chunk: int, declare: bool = False, **kw) -> Callable[[], float]:
+    """A function timing ``chunk`` more steps of one ``gym.make`` env (random actions drawn
+    up front, resets included): steps/s."""
     env = gym.make(env_id, **kw)
     env.reset(seed=0)
     env.action_space.seed(0)
-    acts = [env.action_space.sample() for _ in range(steps)]
+    acts = [env.action_space.sample() for _ in range(max(chunk, 1000))]
     if not declare and isinstance(env.action_space, gym.spaces.Box):
         acts = [_no_declare(a) for a in acts]
-    rates = []
-    for chunk in np.array_split(np.arange(steps), repeats):
+    pos = [0]
+
+    def run(calls: int | None = None) -> float:
+        calls = chunk if calls is None else calls
         t = time.perf_counter()
-        for k in chunk:
-            _, _, te, tr, _ = env.step(acts[k])
+        for _ in range(calls):
+            _, _, te, tr, _ = env.step(acts[pos[0] % len(acts)])
+            pos[0] += 1
             if te or tr:
                 env.reset()
-        rates.append(len(chunk) / (time.perf_counter() - t))
-    env.close()
-    return float(np.median(rates))
+        return calls / (time.perf_counter() - t)
+
+    return run
+
+
+def batched_runner(
+    env_id: str,
+    chunk: int,
+    num_envs: int = N_BATCH,
+    declare: bool = False,
+    warmup: int = 5,
+    **kw,
+) -> Callable[[], float]:
+    """A function timing ``chunk`` more steps of the native vector env
+    (``vector_entry_point``, NEXT_STEP autoresets included): env-steps/s.  ``warmup`` steps
+    are taken first (compiles, fills caches: on a scene pool, the first use of each
+    scene)."""
+    venv = gym.make_vec(env_id, num_envs=num_envs, vectorization_mode="vector_entry_point", **kw)
+    venv.reset(seed=0)
+    venv.action_space.seed(0)
+    acts = [venv.action_space.sample() for _ in range(max(chunk, 50))]
+    if not declare and isinstance(venv.single_action_space, gym.spaces.Box):
+        acts = [_no_declare(a) for a in acts]
+    for k in range(warmup):
+        venv.step(acts[k % len(acts)])
+    pos = [0]
+
+    def run(calls: int | None = None) -> float:
+        calls = chunk if calls is None else calls
+        t = time.perf_counter()
+        for _ in range(calls):
+            venv.step(acts[pos[0] % len(acts)])
+            pos[0] += 1
+        return calls * num_envs / (time.perf_counter() - t)
+
+    return run
+
+
+def _calls_for(run: Callable[..., float], seconds: float) -> int:
+    """How many calls of ``run`` take about ``seconds``."""
+    k = 1
+    while True:
+        t = time.perf_counter()
+        run(k)
+        dt = time.perf_counter() - t
+        if dt >= seconds / 4:
+            return max(1, round(k * seconds / dt))
+        k *= 4
+
+
+def paired(
+    anchor: Callable[..., float],
+    other: Callable[..., float],
+    repeats: int,
+    log: list | None = None,
+    seconds: float = CHUNK_SECONDS,
+):
+    """Alternate chunks of ``anchor`` and ``other``, each about ``seconds`` long (so both
+    see the same load): the median rates and the median of the per-pair ratios ``other /
+    anchor``; the anchor's rates are appended to ``log``."""
+    ka, ko = _calls_for(anchor, seconds), _calls_for(other, seconds)
+    ra, ro = [], []
+    for _ in range(repeats):
+        ra.append(anchor(ka))
+        ro.append(other(ko))
+    if log is not None:
+        log.extend(ra)
+    ratios = np.array(ro) / np.array(ra)
+    return float(np.median(ra)), float(np.median(ro)), float(np.median(ratios))
+
+
+def single_sps(env_id: str, steps: int, repeats: int, declare: bool = False, **kw) -> float:
+    """Median steps/s of one env (resets included) over ``repeats`` chunks."""
+    run = single_runner(env_id, max(steps // repeats, 1), declare, **kw)
+    return float(np.median([run() for _ in range(repeats)]))
 
 
 def batched_sps(
     env_id: str, vsteps: int, repeats: int, num_envs: int = N_BATCH, declare=False, **kw
 ) -> float:
-    """Median env-steps/s of the native vector env (``vector_entry_point``)."""
-    venv = gym.make_vec(env_id, num_envs=num_envs, vectorization_mode="vector_entry_point", **kw)
-    venv.reset(seed=0)
-    venv.action_space.seed(0)
-    acts = [venv.action_space.sample() for _ in range(vsteps)]
-    if not declare and isinstance(venv.single_action_space, gym.spaces.Box):
-        acts = [_no_declare(a) for a in acts]
-    for a in acts[:5]:  # warm-up (compiles, fills caches)
-        venv.step(a)
-    rates = []
-    for chunk in np.array_split(np.arange(vsteps), repeats):
-        t = time.perf_counter()
-        for k in chunk:
-            venv.step(acts[k])
-        rates.append(len(chunk) * num_envs / (time.perf_counter() - t))
-    venv.close()
-    return float(np.median(rates))
+    """Median env-steps/s of the native vector env over ``repeats`` chunks."""
+    run = batched_runner(env_id, max(vsteps // repeats, 1), num_envs, declare, **kw)
+    return float(np.median([run() for _ in range(repeats)]))
 
 
 def numpy_fallback(env_id: str, vsteps: int, repeats: int, **kw) -> float:
@@ -148,20 +216,40 @@ def main(argv=None) -> None:
     nv = 10 if args.quick else 60
     r = args.repeats
 
-    cart = single_sps("CartPole-v1", 4 * n, r)
-    cart_vec = batched_sps("CartPole-v1", 4 * nv, r)
+    cs = max(4 * n // r, 1)  # CartPole chunks: about as long as the env's
+    cart1 = single_runner("CartPole-v1", cs)
+    cartv = batched_runner("CartPole-v1", max(4 * nv // r, 1))
     rows = []
+    c_log: list[float] = []  # every anchor chunk, for the anchor's own row
+    v_log: list[float] = []
     for env_id in IDS:
-        s = single_sps(env_id, n, r)
-        b = batched_sps(env_id, nv, r)
+        _, s, rs = paired(cart1, single_runner(env_id, max(n // r, 1)), r, c_log)
+        brun = batched_runner(env_id, max(nv // r, 1))
+        _, b, rv = paired(cartv, brun, r, v_log)
+        _, _, rb = paired(cart1, brun, r, c_log)
         g = batched_sps(env_id, max(nv // 4, 3), r, obs_type="grid")
         npy = numpy_fallback(env_id, max(nv // 4, 3), r)
-        rows.append((env_id, s, b, g, npy))
-    rec_decl = batched_sps("sensorplan/Recognize-v0", nv, r, declare=True)
-    nav_rand = batched_sps("sensorplan/Navigate-v0", nv, r, scene="random")
+        rows.append((env_id, s, rs, b, rb, rv, g, npy))
+    extra = {
+        name: paired(cart1, batched_runner(env_id, max(nv // r, 1), **kw), r, c_log)
+        for name, env_id, kw in (
+            ("rec_decl", "sensorplan/Recognize-v0", {"declare": True}),
+            (
+                "rec_decl_rand",
+                "sensorplan/Recognize-v0",
+                {"declare": True, "scene": "random", "warmup": 30},
+            ),
+            ("nav_rand", "sensorplan/Navigate-v0", {"scene": "random", "warmup": 30}),
+        )
+    }
+    cart = float(np.median(c_log))
+    cart_vec = float(np.median(v_log))
 
     def ratio(v: float) -> str:
         return f"{v / cart:.2f}x"
+
+    def ex(name: str) -> str:
+        return f"{extra[name][1]:,.0f} env-steps/s ({extra[name][2]:.2f}x)"
 
     lines = [
         "# Environment speed",
@@ -169,24 +257,29 @@ def main(argv=None) -> None:
         f"Machine: {os.cpu_count()} cores, {platform.python_implementation()} "
         f"{platform.python_version()}, numpy {np.__version__}, gymnasium {gym.__version__}.  "
         f"Command: `python -m benchmarks.envs{' --train' if args.train else ''}`.  "
-        f"Medians of {r} chunks; load average at the end: {os.getloadavg()[0]:.1f}.",
+        f"Medians of {r} chunks of about {CHUNK_SECONDS} s; every ratio is the median of {r} "
+        f"ratios of chunks timed alternately with the anchor's (the load changes alike for "
+        f"both); load average at "
+        f"the end: {os.getloadavg()[0]:.1f}.",
         "",
         f"| env (random actions) | single env steps/s | ratio to CartPole | batched x{N_BATCH} "
-        "env-steps/s | ratio | batched grid obs | batched, numpy fallback |",
-        "| --- | ---: | ---: | ---: | ---: | ---: | ---: |",
+        "env-steps/s | ratio to CartPole | ratio to CartPoleVectorEnv | batched grid obs "
+        "| batched, numpy fallback |",
+        "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |",
         f"| CartPole-v1 (anchor) | {cart:,.0f} | 1.00x | {cart_vec:,.0f} (CartPoleVectorEnv) | "
-        f"{ratio(cart_vec)} | | |",
+        f"{ratio(cart_vec)} | 1.00x | | |",
     ]
-    for env_id, s, b, g, npy in rows:
+    for env_id, s, rs, b, rb, rv, g, npy in rows:
         lines.append(
-            f"| {env_id} | {s:,.0f} | {ratio(s)} | {b:,.0f} | {ratio(b)} | {g:,.0f} | {npy:,.0f} |"
+            f"| {env_id} | {s:,.0f} | {rs:.2f}x | {b:,.0f} | {rb:.2f}x | "
+            f"{rv:.3f}x | {g:,.0f} | {npy:,.0f} |"
         )
     lines += [
         "",
-        f"Batched Recognize-v0 with fully random actions (2/3 of the steps declare, so most "
-        f"steps are autoresets): {rec_decl:,.0f} env-steps/s ({ratio(rec_decl)}).  "
-        f'Batched Navigate-v0 on `scene="random"` (a pool of 64 scenes): {nav_rand:,.0f} '
-        f"env-steps/s ({ratio(nav_rand)}).",
+        "Batched Recognize-v0 with fully random actions (2/3 of the steps declare, so most "
+        f'steps are autoresets): {ex("rec_decl")}; on `scene="random"` (a pool of 64 '
+        f"scenes, a new scene at most resets): {ex('rec_decl_rand')}.  Batched Navigate-v0 "
+        f'on `scene="random"`: {ex("nav_rand")}.  Ratios to CartPole-v1 single.',
     ]
     if args.train:
         ts = args.train_steps

@@ -25,6 +25,8 @@ from typing import Any
 import numpy as np
 from gymnasium import spaces
 
+from . import fused
+
 __all__ = ["ACTION_TYPES", "ContinuousActions", "DiscreteActions", "make_actions"]
 
 ACTION_TYPES = ("continuous", "discrete")
@@ -41,13 +43,15 @@ class ContinuousActions:
         """``(k, d)`` float64 actions, validated and clipped to [-1, 1]."""
         shape = (k, self.dim)
         try:
-            a = np.asarray(actions, dtype=np.float64)
+            a = np.array(actions, dtype=np.float64)  # a copy: clipped in place below
         except (TypeError, ValueError) as e:
             raise ValueError(
                 f"action must be a numeric array of shape {shape[1:]}, got {actions!r}"
             ) from e
         if a.shape != shape:
             raise ValueError(f"action must have shape {shape[1:]}, got shape {a.shape[1:]}")
+        if fused.FUSED and fused.clip_unit(a):
+            return a
         if not np.isfinite(a).all():
             raise ValueError(f"action contains NaN or infinite values: {a.tolist()}")
         return np.clip(a, -1.0, 1.0)

@@ -71,9 +71,10 @@ def sweep_batch(px, py, dx, dy, S, radius: float, skin) -> np.ndarray:
         tj = th[rows, j]
         better = tj < t_best
         if better.any():
-            qx = qx0[rows, j] + tj * dx
-            qy = qy0[rows, j] + tj * dy
-            rate = np.maximum(np.abs(qx * dx + qy * dy) / max(radius, 1e-300), 1e-300)
+            with np.errstate(**_ERR):  # rows without a hit (tj = inf) are masked below
+                qx = qx0[rows, j] + tj * dx
+                qy = qy0[rows, j] + tj * dy
+                rate = np.maximum(np.abs(qx * dx + qy * dy) / max(radius, 1e-300), 1e-300)
             t_best = np.where(better, tj, t_best)
             back = np.where(better, skin / rate, back)
     res = np.where(t_best >= 1.0, 1.0, np.maximum(0.0, t_best - back))

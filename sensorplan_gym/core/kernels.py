@@ -32,6 +32,7 @@ except ImportError:  # pragma: no cover
 
 __all__ = [
     "HAVE_NUMBA",
+    "libm",
     "cast",
     "cast_numpy",
     "point_sweep",
@@ -41,6 +42,19 @@ __all__ = [
 ]
 
 _ERR = {"divide": "ignore", "invalid": "ignore", "over": "ignore"}
+_UFUNCS: dict = {}
+
+
+def libm(f, *args: np.ndarray) -> np.ndarray:
+    """``f`` (a :mod:`math` function: the C library's, as numba calls it) elementwise over
+    the broadcast float64 ``args``.  The numpy paths use it where numpy's own version may
+    differ in the last bit (``arctan2``, ``arcsin`` and, on some builds, ``cos``/``sin`` use
+    SIMD implementations), so that they answer bitwise as the compiled kernels do."""
+    u = _UFUNCS.get(f)
+    if u is None:
+        u = _UFUNCS[f] = np.frompyfunc(f, len(args), 1)
+    out = u(*args)
+    return np.asarray(out, dtype=np.float64)
 
 
 def cast_numpy(ox, oy, dx, dy, x0, y0, ex, ey, nx, ny, max_range, cull=False):
@@ -75,9 +89,9 @@ def cast_numpy(ox, oy, dx, dy, x0, y0, ex, ey, nx, ny, max_range, cull=False):
     rows = np.arange(len(ox))[:, None]
     r = rows if x0.shape[0] > 1 else 0
     gx, gy = nx[r, idx], ny[r, idx]
-    side = -(gx * ax[rows, idx] + gy * ay[rows, idx])
-    sgn = np.sign(side) * hit
-    return dist, hit, gx * sgn, gy * sgn
+    sgn = np.sign(-(gx * ax[rows, idx] + gy * ay[rows, idx]))
+    # +0.0 where nothing was hit (as the compiled loop writes it: bitwise, not just equal)
+    return dist, hit, np.where(hit, gx * sgn, 0.0), np.where(hit, gy * sgn, 0.0)
 
 
 def _front(ox, oy, x0, y0, nx, ny) -> np.ndarray:

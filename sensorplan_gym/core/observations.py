@@ -44,6 +44,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 from gymnasium import spaces
 
+from . import fused
+from .kernels import libm
 from .sensor import RangeSensor
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -103,11 +105,40 @@ class RobotVectorObs:
             low.astype(np.float32), np.ones(8 + 3 * n + m, dtype=np.float32), dtype=np.float32
         )
 
+    @property
+    def head(self) -> int:
+        """Entries the compiled kernel writes: pose, G and H, the scan (and map ranges)."""
+        return 8 + (4 if self.map_ranges else 3) * self.n
+
     def __call__(self, sim: BatchSim, idx: np.ndarray) -> np.ndarray:
+        """Observations ``(k, D)`` float32 of sub-environments ``idx``."""
+        if sim.fused:
+            out = np.empty((len(idx), self.space.shape[0]), dtype=np.float32)
+            fused.obs_kernel(
+                idx, sim.P, sim.obs_consts, sim.scan_dist, sim.scan_normal, sim.map_dist,
+                sim.params, out,
+            )  # fmt: skip
+            if self.head < out.shape[1]:
+                sel = sim.sel(idx)
+                out[:, self.head :] = self.tail(sim, sel, sim.x[sel], sim.y[sel], sim.psi[sel])
+            return out
+        return self._numpy(sim, idx)
+
+    def tail(self, sim: BatchSim, sel, x, y, psi) -> np.ndarray:
+        """The entries after :attr:`head` ``(k, D - head)`` float64: ``map_evidence``'s
+        flags, then ``sensor_fov``.  A new entry goes here (and in the space's bounds)."""
+        parts = []
+        if self.map_evidence:
+            parts.append(map_evidence(sim, sel, x, y, psi).reshape(len(x), 2 * self.n))
+        if self.sensor_fov:
+            parts.append((sim.fov[sel] / (2.0 * math.pi))[:, None])
+        return np.concatenate(parts, axis=1)
+
+    def _numpy(self, sim: BatchSim, idx: np.ndarray) -> np.ndarray:
         sel = sim.sel(idx)
         x, y, psi = sim.x[sel], sim.y[sel], sim.psi[sel]
         K = sim.obs_consts[sel]  # lo, 2 / span, 1 / diameter, 1 / reach, G, H centres
-        c, s = np.cos(psi), np.sin(psi)
+        c, s = libm(math.cos, psi), libm(math.sin, psi)
         n = self.n
         out = np.empty((len(x), self.space.shape[0]))
         out[:, 0] = (x - K[:, 0]) * K[:, 2] - 1.0
@@ -124,15 +155,10 @@ class RobotVectorObs:
         nrm = sim.scan_normal[sel]  # robot-frame x's, then y's
         out[:, 8 + n : 8 + 2 * n] = c1 * nrm[..., 0] + s1 * nrm[..., 1]
         out[:, 8 + 2 * n : 8 + 3 * n] = c1 * nrm[..., 1] - s1 * nrm[..., 0]
-        j = 8 + 3 * n
         if self.map_ranges:
-            out[:, j : j + n] = sim.map_dist[sel] * K[:, 5:6]
-            j += n
-        if self.map_evidence:
-            out[:, j : j + 2 * n] = map_evidence(sim, sel, x, y, psi).reshape(len(x), 2 * n)
-            j += 2 * n
-        if self.sensor_fov:
-            out[:, j] = sim.fov[sel] / (2.0 * math.pi)
+            out[:, 8 + 3 * n : 8 + 4 * n] = sim.map_dist[sel] * K[:, 5:6]
+        if self.head < out.shape[1]:
+            out[:, self.head :] = self.tail(sim, sel, x, y, psi)
         # every entry is within its bounds up to rounding of order 1e-16, which the float32
         # conversion absorbs (values within 2**-25 of +-1 round to +-1)
         return out.astype(np.float32)
@@ -200,17 +226,20 @@ def _rasters(sim: BatchSim, idx: np.ndarray, size: int) -> np.ndarray:
 class PlacementVectorObs:
     def __init__(self, n_beams: int, grid_size: int = 64) -> None:
         self.n = n_beams
+        self._key = f"placement_vec{n_beams}"
         low = np.concatenate([-np.ones(4), np.zeros(4 + 2 * n_beams)]).astype(np.float32)
         self.space = spaces.Box(low, np.ones(8 + 2 * n_beams, dtype=np.float32), dtype=np.float32)
 
     def __call__(self, sim: BatchSim, idx: np.ndarray) -> np.ndarray:
         if sim._one_world:
-            return np.tile(self.of_world(sim.worlds[0]), (len(idx), 1))
+            out = np.empty((len(idx), self.space.shape[0]), dtype=np.float32)
+            out[:] = self.of_world(sim.worlds[0])
+            return out
         return np.stack([self.of_world(sim.worlds[i]) for i in idx.tolist()])
 
     def of_world(self, world: World) -> np.ndarray:
         """The (constant) observation of one world, computed once."""
-        key = f"placement_vec{self.n}"
+        key = self._key
         cached = world._cache.get(key)
         if cached is not None:
             return cached

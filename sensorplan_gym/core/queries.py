@@ -14,6 +14,7 @@ import math
 import numpy as np
 import shapely
 
+from .kernels import libm
 from .segments import point_segment_distance
 
 __all__ = ["aim_ok_batch", "in_region_batch", "region_distance_batch"]
@@ -72,7 +73,8 @@ def aim_ok_batch(
         return ok
     dvx = hulls[..., 0] - x[:, None, None]  # (N, 2, K)
     dvy = hulls[..., 1] - y[:, None, None]
-    dist = np.hypot(dvx, dvy)
+    # libm's atan2 / asin and sqrt(x^2 + y^2): the compiled kernel's expressions, bitwise
+    dist = np.sqrt(dvx * dvx + dvy * dvy)
     ok &= ~(dist.max(axis=(1, 2)) + eps_pos > max_range)
     part = ~full & ok
     if not part.any():
@@ -81,16 +83,17 @@ def aim_ok_batch(
     ex = np.roll(hulls[..., 0], -1, axis=2) - hulls[..., 0]
     ey = np.roll(hulls[..., 1], -1, axis=2) - hulls[..., 1]
     inside = np.all(ex * (-dvy) - ey * (-dvx) >= 0, axis=2).any(axis=1)
-    base = np.arctan2(centers[..., 1] - y[:, None], centers[..., 0] - x[:, None])  # (N, 2)
-    rel = _wrap(np.arctan2(dvy, dvx) - base[..., None])
+    base = libm(math.atan2, centers[..., 1] - y[:, None], centers[..., 0] - x[:, None])  # (N, 2)
+    rel = _wrap(libm(math.atan2, dvy, dvx) - base[..., None])
     off = _wrap(base - psi[:, None])
     margin = np.broadcast_to(eps_aim[:, None], off.shape).copy()
     pos = eps_pos > 0
     if pos.any():
         L2 = np.maximum(ex * ex + ey * ey, 1e-300)
         t = np.clip((dvx * -ex + dvy * -ey) / L2, 0, 1)
-        dmin = np.min(np.hypot(-dvx - t * ex, -dvy - t * ey), axis=2)
-        extra = np.arcsin(np.minimum(1.0, eps_pos[:, None] / np.maximum(dmin, 1e-300)))
+        qx, qy = -dvx - t * ex, -dvy - t * ey
+        dmin = np.min(np.sqrt(qx * qx + qy * qy), axis=2)
+        extra = libm(math.asin, np.minimum(1.0, eps_pos[:, None] / np.maximum(dmin, 1e-300)))
         margin = margin + np.where(pos[:, None], extra, 0.0)
     half = 0.5 * fov[:, None]
     bad = (off + rel.min(axis=2) < -half + margin) | (off + rel.max(axis=2) > half - margin)

@@ -126,6 +126,14 @@ class SegmentRows:
     def m(self) -> int:
         return self.data.shape[2]
 
+    def reserve(self, m: int) -> None:
+        """Room for ``m`` segments per row (grows, re-padding, when needed)."""
+        if m > self.m:
+            grow = np.zeros((6, self.data.shape[1], m - self.m))
+            grow[0] = grow[1] = PAD
+            self.data = np.concatenate([self.data, grow], axis=2)
+            self._views()
+
     def set_row(self, i: int, rows: np.ndarray) -> None:
         """Row ``i`` := the ``(6, k)`` padded arrays ``rows`` (see :func:`pad_segments`)."""
         k = rows.shape[1]

@@ -317,8 +317,11 @@ class World:
     def batch_rows(self) -> dict[str, Any]:
         """This world as the batched core reads it (computed once): ``segs`` ``(6, S)`` edge
         arrays (:func:`.segments.pad_segments`), ``region_segs`` ``(6, R)`` region boundary,
-        ``hulls`` ``(2, K, 2)`` K_G and K_H padded by repeating their last vertex,
-        ``centers`` ``(2, 2)`` their vertex means, ``field`` (:meth:`clearance_field`)."""
+        ``region_xy`` ``(4, R)`` the same segments' end points (exact vertices, for the
+        compiled region test), ``space_xy`` ``(4, F)`` the robot's free space likewise,
+        ``hulls`` ``(2, K, 2)`` K_G and K_H padded by repeating their
+        last vertex, ``centers`` ``(2, 2)`` their vertex means, ``field``
+        (:meth:`clearance_field`)."""
         r = self._cache.get("rows")
         if r is None:
             k = max(len(h) for h in self.must_see)
@@ -329,6 +332,10 @@ class World:
                 "segs": pad_segments(self.segs, self.seg_normals, self.segs.shape[0]),
                 "region_segs": pad_segments(
                     self.region_segs, segment_normals(self.region_segs), self.region_segs.shape[0]
+                ),
+                "region_xy": np.ascontiguousarray(self.region_segs.T, dtype=np.float64),
+                "space_xy": np.ascontiguousarray(
+                    boundary_segments(self.robot_space).T, dtype=np.float64
                 ),
                 "hulls": hulls,
                 "centers": np.stack([h.mean(axis=0) for h in self.must_see]),

@@ -4,7 +4,11 @@ Each task (Placement, Navigate, Recognize) is written once, as a *batch* class
 (:class:`SensorPlanBatch`, a :class:`~sensorplan_gym.core.sim.BatchSim`) whose ``reset_envs``
 and ``step_envs`` advance any subset of N sub-environments with array operations.  The
 Gymnasium single env :class:`SensorPlanEnv` is the batch of one; the native vector env
-(:mod:`sensorplan_gym.envs.vector`) is the batch of N.  There is no second implementation.
+(:mod:`sensorplan_gym.envs.vector`) is the batch of N.  There is no second implementation:
+with numba (the ``fast`` extra) a step of Navigate or Recognize is one compiled call over
+the stepping rows (:mod:`sensorplan_gym.core.fused`) and the single env makes that call with
+one row; without numba the numpy path of the same batch classes runs, with bitwise the same
+answers (``tests/test_fused.py`` compares whole episodes).
 
 Common keyword arguments (``gym.make(id, **kwargs)`` and ``gym.make_vec(id, **kwargs)``)
 ----------------------------------------------------------------------------------------
@@ -69,13 +73,14 @@ import gymnasium as gym
 import numpy as np
 import shapely
 
+from ..core import fused
 from ..core.actions import make_actions
 from ..core.cache import get_world
 from ..core.observations import make_observation
 from ..core.pool import FixedScene, shared_pool
 from ..core.rendering import HumanViewer, Renderer
 from ..core.sensor import NOISE_BOUND, RangeSensor
-from ..core.sim import BLOCK, BatchSim
+from ..core.sim import BatchSim
 from ..core.world import World, WorldConfig, load_scene
 
 __all__ = ["SPEED_LIMITS", "RobotBatch", "SensorPlanBatch", "SensorPlanEnv"]
@@ -243,6 +248,9 @@ class SensorPlanBatch(BatchSim):
             if v and (obs_type != "vector" or self.obs_kind != "robot"):
                 raise ValueError(f"{name}=True needs obs_type='vector' in Navigate or Recognize")
         self.map_ranges = map_ranges or map_evidence  # the sim computes the map's ranges
+        self.params[fused.P_MAP] = self.map_ranges
+        self.params[fused.P_OBS_MAP] = map_ranges
+        self.params[fused.P_MAX_STEPS] = self.max_steps
         self.obs_type = obs_type
         self.obs = make_observation(
             self.obs_kind,
@@ -257,7 +265,6 @@ class SensorPlanBatch(BatchSim):
         self.actions = make_actions(action_type, self.action_task, self.action_dim, **action_kw)
         self.action_type = action_type
         self.single_action_space = self.actions.space
-        self.elapsed = np.zeros(self.n, dtype=np.int64)
         self.random = isinstance(scene, str) and scene == "random"
         if not isinstance(min_start_distance, (int, float)) or not 0 <= min_start_distance < 1:
             raise ValueError(f"min_start_distance must be in [0, 1), got {min_start_distance!r}")
@@ -298,13 +305,22 @@ class SensorPlanBatch(BatchSim):
     def reset_envs(self, idx: np.ndarray, options: dict | None = None) -> None:
         """Start new episodes in sub-environments ``idx``."""
         options = options or {}
-        for i in idx.tolist():
-            world, start = self.source.draw(self.rngs[i])
-            self.load_world(i, world)
-            self.starts[i] = start
-            self.elapsed[i] = 0
-            self._reset_one(i, options)
+        src = self.source
+        if not (
+            isinstance(src, FixedScene) and self._one_world and self.worlds[0] is src.world
+        ):  # a fixed scene is loaded in every row already, and its start never changes
+            drawn = [src.draw(self.rngs[i]) for i in idx.tolist()]
+            self.load_worlds(idx, [w for w, _ in drawn])
+            self.starts[idx] = [s for _, s in drawn]
+        self.elapsed[idx] = 0
+        self._reset_rows(idx, options)
         self._after_reset(idx)
+
+    def _reset_rows(self, idx: np.ndarray, options: dict) -> None:
+        """The task's own reset of rows ``idx`` (their worlds loaded); by default
+        :meth:`_reset_one` row by row."""
+        for i in idx.tolist():
+            self._reset_one(i, options)
 
     def _reset_one(self, i: int, options: dict) -> None:  # pragma: no cover - abstract
         raise NotImplementedError
@@ -395,6 +411,66 @@ class RobotBatch(SensorPlanBatch):
         self.dist = np.zeros(n)  # distance to the region at the last step (shaping)
         self.shaping = getattr(self, "shaping", 0.0)
         super().__init__(n, scene, **kwargs)
+        self.params[fused.P_MAX_TURN] = self.max_turn
+        self.params[fused.P_DISC] = speed_limit == "disc"
+        self.params[fused.P_SHAPING] = self.shaping
+        self.params[fused.P_STEP_COST] = getattr(self, "step_cost", 0.0)
+
+    @property
+    def compiled_step(self) -> bool:
+        """Whether :meth:`step_envs` runs the fused compiled kernel (numba installed, a
+        point robot); else the numpy path (bitwise the same answers)."""
+        return self.fused and self.robot_radius == 0.0
+
+    def _step_compiled(self, act: np.ndarray, idx: np.ndarray, task: int):
+        """:func:`.fused.robot_step` of rows ``idx``: ``(reward (k,), flags (5, k), dist
+        (k,))`` with flags terminated, truncated, recognizing, in region, aim ok."""
+        if self._empty:
+            self._refill(idx)
+        args = self._kargs
+        if args is None:
+            args = self._kargs = self._step_args()
+        if act.dtype != np.float64 or not act.flags.c_contiguous:
+            act = np.ascontiguousarray(act, dtype=np.float64)
+        if fused.robot_step(task, idx, act, *args):
+            self._note_used(idx)
+        b = self._kbuf
+        k = len(idx)
+        return b.reward[:k].copy(), b.flags[:, :k].copy(), b.dist[:k].copy()
+
+    def _step_args(self) -> tuple:
+        """The arrays :func:`.fused.robot_step` reads and writes (after ``task, idx, act``);
+        rebuilt when a world or the segments change (arrays may be reallocated)."""
+        b = self._kbuf
+        return (
+            self.params,
+            self.P,
+            self.C,
+            self.stochastic,
+            self.aim_trivial,
+            self.OFF,
+            self.segs.data,
+            self.static_segs.data,
+            self.region_xy,
+            self.region_segs.data,
+            self.hulls,
+            self.centers,
+            self._U,
+            self._Z,
+            self._ptr,
+            self.scan_dist,
+            self.scan_normal,
+            self.scan_hit,
+            self.scan_ang,
+            self.map_dist,
+            self.has_scan,
+            self.dist,
+            self.I8,
+            self.collided,
+            b.reward,
+            b.flags,
+            b.dist,
+        )
 
     def load_world(self, i: int, world: World, max_speed: float | None = None) -> None:
         super().load_world(i, world, self._max_speed_cfg)
@@ -434,6 +510,16 @@ class RobotBatch(SensorPlanBatch):
         else:
             self.set_pose(i, self.episode_start(i))
         self.collided[i] = False
+
+    def _reset_starts(self, idx: np.ndarray, options: dict) -> None:
+        """Put the robots of rows ``idx`` at their episode starts (see ``random_start`` and
+        ``options["start"]``), not collided."""
+        if options.get("start") is None and not self.random_start:
+            self.P[:3, idx] = self.starts[idx].T
+            self.collided[idx] = False
+        else:
+            for i in idx.tolist():
+                self._start_from_options(i, options)
 
     def _after_reset(self, idx: np.ndarray) -> None:
         self.sense(idx)
@@ -503,7 +589,7 @@ class SensorPlanEnv(gym.Env):
     @np_random.setter
     def np_random(self, value: np.random.Generator) -> None:
         self.batch.rngs[0] = value
-        self.batch._ptr[0] = BLOCK
+        self.batch.drop_block(0)
 
     @property
     def world(self) -> World:
@@ -576,7 +662,13 @@ class SensorPlanEnv(gym.Env):
         out = {}
         for k, (v, m) in cols.items():
             if m is None or m[0]:
-                out[k] = _one_row(v[0])
+                x = v[0]
+                if isinstance(x, np.generic):
+                    out[k] = x.item()
+                elif isinstance(x, np.ndarray):
+                    out[k] = tuple(x.tolist()) if x.dtype.kind == "f" else x.tolist()
+                else:
+                    out[k] = x
         return out
 
     def render(self):

@@ -39,6 +39,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..core import fused
 from .base import RobotBatch, SensorPlanEnv
 
 __all__ = ["NavigateBatch", "NavigateEnv"]
@@ -48,6 +49,7 @@ class NavigateBatch(RobotBatch):
     """Navigate-v0 over N sub-environments (see the module docstring)."""
 
     obs_kind = "robot"
+    I8_NAMES = ("elapsed", "success")
 
     def __init__(
         self,
@@ -62,12 +64,12 @@ class NavigateBatch(RobotBatch):
         self.step_cost = float(step_cost)
         self.success_bonus = float(success_bonus)
         self.shaping = float(shaping)
-        self.success = np.zeros(n, dtype=bool)
         super().__init__(n, scene, **kwargs)
+        self.params[fused.P_SUCCESS_BONUS] = self.success_bonus
 
-    def _reset_one(self, i: int, options: dict) -> None:
-        self._start_from_options(i, options)
-        self.success[i] = False
+    def _reset_rows(self, idx: np.ndarray, options: dict) -> None:
+        self._reset_starts(idx, options)
+        self.success[idx] = 0
 
     def _after_reset(self, idx: np.ndarray) -> None:
         super()._after_reset(idx)
@@ -78,16 +80,19 @@ class NavigateBatch(RobotBatch):
         return self._cols(idx, rec, dist)
 
     def _cols(self, idx, rec, dist) -> dict:
-        pose = np.stack([self.x[idx], self.y[idx], self.psi[idx]], axis=1)
+        pose = self.P[:3, idx].T
         return {
             "is_success": (rec, None),
             "recognizing": (rec, None),
             "distance_to_region": (dist, None),
-            "collided": (self.collided[idx].copy(), None),
+            "collided": (self.collided[idx], None),
             "pose": (pose, None),
         }
 
     def step_envs(self, act: np.ndarray, idx: np.ndarray):
+        if self.compiled_step:
+            reward, f, dist = self._step_compiled(act, idx, fused.NAVIGATE)
+            return reward, f[2], f[1], self._cols(idx, f[2], dist)
         self.elapsed[idx] += 1
         self.move(act, idx)
         rec, _, _, dist = self.query(idx)

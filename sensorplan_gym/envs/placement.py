@@ -35,6 +35,7 @@ from typing import Any
 
 import numpy as np
 
+from ..core import fused
 from .base import SensorPlanBatch, SensorPlanEnv
 
 __all__ = ["PlacementBatch", "PlacementEnv"]
@@ -52,6 +53,7 @@ class PlacementBatch(SensorPlanBatch):
         self.shaping = float(shaping)
         self.placed = np.zeros(n, dtype=bool)
         super().__init__(n, scene, **kwargs)
+        self.params[fused.P_SHAPING] = self.shaping
 
     def _has_pose(self, i: int) -> bool:
         return bool(self.placed[i])
@@ -93,6 +95,8 @@ class PlacementBatch(SensorPlanBatch):
         return reward, cols
 
     def step_envs(self, act: np.ndarray, idx: np.ndarray):
+        if self.fused:
+            return self._step_compiled(act, idx)
         pose = self.action_to_pose(act, idx)
         reward, cols = self.evaluate(pose, idx)
         self.x[idx], self.y[idx], self.psi[idx] = pose.T
@@ -107,6 +111,60 @@ class PlacementBatch(SensorPlanBatch):
         cols["executed_pose"] = (executed, None)
         k = len(idx)
         return reward, np.ones(k, dtype=bool), np.zeros(k, dtype=bool), cols
+
+    def _step_compiled(self, act: np.ndarray, idx: np.ndarray):
+        """:meth:`step_envs` by :func:`.fused.placement_step` (one call; another after
+        each refill of a row's pre-drawn numbers)."""
+        k = len(idx)
+        res = np.empty((12, k))
+        if act.dtype != np.float64 or not act.flags.c_contiguous:
+            act = np.ascontiguousarray(act, dtype=np.float64)
+        args = self._kargs
+        if args is None:
+            args = self._kargs = (
+                self.params,
+                self.P,
+                self.C,
+                self.stochastic,
+                self.aim_trivial,
+                self.lo,
+                self.hi,
+                self.region_xy,
+                self.region_segs.data,
+                self.space_xy,
+                self.hulls,
+                self.centers,
+                self.OFF,
+                self.segs.data,
+                self._U,
+                self._Z,
+                self._ptr,
+                self.scan_dist,
+                self.scan_normal,
+                self.scan_hit,
+                self.scan_ang,
+                self.has_scan,
+                self.placed,
+            )
+        k0 = 0
+        while True:
+            k0 = fused.placement_step(k0, idx, act, *args, res)
+            if k0 == k:
+                break
+            self._refill(idx[k0 : k0 + 1])
+        if self.n_stochastic:
+            self._note_used(idx)
+        flags = res[1:4] != 0.0
+        cols = {
+            "is_success": (flags[0], None),
+            "recognizing": (flags[0].copy(), None),
+            "in_region": (flags[1], None),
+            "aim_ok": (flags[2], None),
+            "distance_to_region": (res[4], None),
+            "pose": (res[6:9].T, None),
+            "executed_pose": (res[9:12].T, None),
+        }
+        return res[0], np.ones(k, dtype=bool), np.zeros(k, dtype=bool), cols
 
 
 class PlacementEnv(SensorPlanEnv):

@@ -46,9 +46,10 @@ import math
 from typing import Any
 
 import numpy as np
-import shapely
 
+from ..core import fused
 from ..core.segments import SegmentRows, pad_segments, point_segment_distance, segment_normals
+from ..core.targets import TargetTables, place_targets
 from .base import RobotBatch, SensorPlanEnv
 
 __all__ = ["RecognizeBatch", "RecognizeEnv"]
@@ -63,6 +64,9 @@ class RecognizeBatch(RobotBatch):
     obs_kind = "robot"
     action_dim = 4
     action_task = "recognize"
+    # side: _G or _H, where the hidden target is; hold: consecutive steps pointing at one
+    # label; pointing: that label; declared: the declared label (_NONE: none yet)
+    I8_NAMES = ("elapsed", "side", "hold", "pointing", "declared")
 
     def __init__(
         self,
@@ -81,50 +85,79 @@ class RecognizeBatch(RobotBatch):
         self.step_cost = float(step_cost)
         self.shaping = float(shaping)
         self.declare_hold = int(declare_hold)
-        self.hold = np.zeros(n, dtype=np.int64)  # consecutive steps pointing at one label
-        self.pointing = np.zeros(n, dtype=np.int8)
-        self.side = np.zeros(n, dtype=np.int8)  # _G or _H: where the hidden target is
-        self.declared = np.zeros(n, dtype=np.int8)
-        self.target_polys: list[np.ndarray | None] = [None] * n
-        self.tsegs = SegmentRows(n)
+        self.tsegs = SegmentRows(n)  # the target's edges
+        self.tt = TargetTables(n)
+        self.placed = np.zeros(n, dtype=bool)
         super().__init__(n, scene, **kwargs)
+        self.params[fused.P_DECLARE_HOLD] = self.declare_hold
 
-    def _place_target(self, i: int) -> None:
-        """Hide the target in G or H (uniformly) and add its edges to row ``i``'s segments."""
-        w = self.worlds[i]
-        rng = self.rngs[i]
-        side = _G if rng.random() < 0.5 else _H
-        which = "goal" if side == _G else "failure"
-        k = _hidden_target(w)
-        # the robot disc must not meet the target at the start: it cannot when it keeps clear
-        # of the hull of every placement (the must-see hull), else re-draw up to 20 times
-        xy = (self.x[i], self.y[i])
-        far = k["hulls"][side - 1].distance(shapely.Point(xy)) > w.robot_radius + 1e-9
-        for _ in range(20):
-            q = w.sample_in(which, rng)
-            th = rng.uniform(0.0, 2 * math.pi) if w.theta is None else 0.0
-            c, s = math.cos(th), math.sin(th)
-            poly = w.target @ np.array([[c, s], [-s, c]]) + q
-            if far or shapely.Polygon(poly).distance(shapely.Point(xy)) > w.robot_radius + 1e-9:
-                break
-        self.side[i] = side
-        self.target_polys[i] = poly
-        if w.theta is None:
-            segs = np.concatenate([poly, np.roll(poly, -1, axis=0)], axis=1)
-            rows = pad_segments(segs, _outward(segs), len(segs))
-        else:  # a translate of the target's own edges
-            rows = k["rows"].copy()
-            rows[0] += q[0]
-            rows[1] += q[1]
-        self.tsegs.set_row(i, rows)
-        self.set_segments(i, np.concatenate([k["static"], rows], axis=1))
+    def load_world(self, i: int, world, max_speed: float | None = None) -> None:
+        if self.worlds[i] is world:
+            return
+        super().load_world(i, world, max_speed)
+        nstat = world.batch_rows()["segs"].shape[1]
+        v = len(world.target)
+        self.tt.load(i, world, _hidden_target(world), nstat)
+        self.segs.reserve(nstat + v)
+        self.tsegs.reserve(v)
+        self.placed[i] = False
 
-    def _reset_one(self, i: int, options: dict) -> None:
-        self._start_from_options(i, {})
-        self.declared[i] = _NONE
-        self.hold[i] = 0
-        self.pointing[i] = _NONE
-        self._place_target(i)
+    def _row_arrays(self) -> list[tuple[np.ndarray, int]]:
+        T = self.tt
+        return super()._row_arrays() + [
+            (a, 0)
+            for a in (T.tri, T.cum, T.ntri, T.pts, T.tgt, T.nv, T.rot, T.H, T.nh, T.trows, T.nstat)
+        ]
+
+    def _rows_loaded(self, rows: np.ndarray) -> None:
+        self.placed[rows] = False
+
+    def drop_block(self, i: int) -> None:
+        super().drop_block(i)
+        self.tt.uptr[i] = self.tt.U.shape[1]  # the target's uniforms too
+
+    @property
+    def target_polys(self) -> list[np.ndarray | None]:
+        """The hidden target's vertices ``(V, 2)`` (world frame) per row (``None`` before
+        the first reset); copies."""
+        T = self.tt
+        return [T.poly[i, : T.nv[i]].copy() if self.placed[i] else None for i in range(self.n)]
+
+    def _place_targets(self, idx: np.ndarray) -> None:
+        """Hide the targets of rows ``idx`` in G or H (:func:`.core.targets.place_targets`)
+        and add their edges to the rows' segments."""
+        T = self.tt
+        T.refill(idx, self.rngs)
+        place_targets(
+            idx,
+            T.U,
+            T.uptr,
+            self.P,
+            self.robot_radius,
+            T.tri,
+            T.cum,
+            T.ntri,
+            T.pts,
+            T.tgt,
+            T.nv,
+            T.rot,
+            T.H,
+            T.nh,
+            T.trows,
+            T.nstat,
+            self.segs.data,
+            self.tsegs.data,
+            self.side,
+            T.poly,
+        )
+        self.placed[idx] = True
+
+    def _reset_rows(self, idx: np.ndarray, options: dict) -> None:
+        self._reset_starts(idx, {})
+        self.declared[idx] = _NONE
+        self.hold[idx] = 0
+        self.pointing[idx] = _NONE
+        self._place_targets(idx)
 
     def _after_reset(self, idx: np.ndarray) -> None:
         super()._after_reset(idx)
@@ -141,20 +174,23 @@ class RecognizeBatch(RobotBatch):
     def reset_info(self, idx: np.ndarray) -> dict:
         return self._cols(idx, np.zeros(len(idx), dtype=bool))
 
-    def _cols(self, idx: np.ndarray, ended: np.ndarray) -> dict:
-        rec, _, _, dist = self.query(idx)
+    def _cols(self, idx: np.ndarray, ended: np.ndarray, q=None) -> dict:
+        rec, dist = (self.query(idx)[::3]) if q is None else q
         dec = self.declared[idx]
         return {
             "is_success": ((dec != _NONE) & (dec == self.side[idx]), None),
             "declared": (_LABEL[dec], None),
             "recognizing": (rec, None),
             "distance_to_region": (dist, None),
-            "collided": (self.collided[idx].copy(), None),
-            "pose": (np.stack([self.x[idx], self.y[idx], self.psi[idx]], axis=1), None),
+            "collided": (self.collided[idx], None),
+            "pose": (self.P[:3, idx].T, None),
             "target_in": (_LABEL[self.side[idx]], ended),
         }
 
     def step_envs(self, act: np.ndarray, idx: np.ndarray):
+        if self.compiled_step:
+            reward, f, dist = self._step_compiled(act, idx, fused.RECOGNIZE)
+            return reward, f[0], f[1], self._cols(idx, f[0] | f[1], (f[2], dist))
         self.elapsed[idx] += 1
         self.move(act, idx)
         d = act[:, 3]
@@ -190,21 +226,14 @@ def _outward(segs: np.ndarray) -> np.ndarray:
     return -n if area2 > 0 else n  # counter-clockwise: left normals point inwards
 
 
-def _hidden_target(w) -> dict:
-    """Per-world constants for placing the target (cached on the world): its edges at the
-    origin as ``(6, T)`` rows, the static rows, and the must-see hulls as polygons."""
-    k = w._cache.get("hidden_target")
+def _hidden_target(w) -> np.ndarray:
+    """The target's edges at the origin as ``(6, T)`` rows, normals pointing out of it
+    (cached on the world)."""
+    k = w._cache.get("hidden_target_rows")
     if k is None:
         poly = np.asarray(w.target, dtype=np.float64)
         segs = np.concatenate([poly, np.roll(poly, -1, axis=0)], axis=1)
-        hulls = [shapely.Polygon(h) for h in w.must_see]
-        for h in hulls:
-            shapely.prepare(h)
-        k = w._cache["hidden_target"] = {
-            "rows": pad_segments(segs, _outward(segs), len(segs)),
-            "static": w.batch_rows()["segs"],
-            "hulls": hulls,
-        }
+        k = w._cache["hidden_target_rows"] = pad_segments(segs, _outward(segs), len(segs))
     return k
 
 

@@ -171,6 +171,15 @@ class SensorPlanVectorEnv(VectorEnv):
         """Write info columns of sub-environments ``idx`` into ``infos`` (arrays over all
         N with ``_key`` masks)."""
         n = self.num_envs
+        if not infos and len(idx) == n:  # every sub-environment: the columns themselves
+            for key, (vals, m) in cols.items():
+                infos[key] = np.array(vals)  # a copy: columns may share arrays
+                infos["_" + key] = np.ones(n, dtype=bool) if m is None else np.array(m)
+                if m is not None and vals.dtype == object:
+                    infos[key][~m] = None
+                elif m is not None:
+                    infos[key][~m] = 0
+            return infos
         for key, (vals, m) in cols.items():
             vals = np.asarray(vals)
             if key not in infos:

@@ -35,6 +35,7 @@ def test_compiled_equals_numpy(shape, shared):
         a = kernels.cast(ox, oy, np.cos(ang), np.sin(ang), *seg, mr, cull)
         c = kernels.cast_numpy(ox, oy, np.cos(ang), np.sin(ang), *seg, mr, cull)
         assert all(np.array_equal(x, y) for x, y in zip(a, c, strict=True))
+        assert all(x.tobytes() == y.tobytes() for x, y in zip(a, c, strict=True))  # +-0 too
         assert a[1].any() and not a[1].all()  # both hits and misses were compared
     d = rng.normal(0, 10, (2, n))
     d[:, -1] = 0.0  # no motion
