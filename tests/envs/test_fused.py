@@ -195,12 +195,12 @@ def test_numpy_fallback_without_numba_gives_the_same_episodes():
     cases = [CASES[1], CASES[2], CASES[4], CASES[5], CASES[8], CASES[10]]
     steps = 120
     code = (
-        "import json, sys; from tests.test_fused import _digest; "
+        "import json, sys; from tests.envs.test_fused import _digest; "
         "cases = json.loads(sys.argv[1]); "
         "print(json.dumps([_digest(e, k, int(sys.argv[2])) for e, k in cases]))"
     )
     env = dict(os.environ, SENSORPLAN_NO_NUMBA="1")
-    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
     out = subprocess.run(
         [sys.executable, "-c", code, json.dumps(cases), str(steps)],
         env=env,
