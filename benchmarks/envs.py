@@ -2,7 +2,9 @@
 
     python -m benchmarks.envs [--quick] [--train]
 
-Writes a markdown table to ``benchmarks/results/envs.md`` (and prints it).
+Prints the table and writes the data (``envs.json``) and the page fragment (``envs.md``) to
+``--out`` (default ``runs/benchmarks/envs/``), or with ``--update-results`` to the tracked
+``benchmarks/results/envs.json`` and ``docs/results/envs.md``.
 
 * **single env**: ``gym.make(id)`` with its standard wrappers, random actions drawn up front,
   resets included when an episode ends; CartPole-v1 the same way.
@@ -26,17 +28,19 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import platform
 import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
+from typing import Any
 
 import gymnasium as gym
 import numpy as np
 
 import sensorplan_gym  # noqa: F401
+
+from . import _results
 
 IDS = ["sensorplan/Placement-v0", "sensorplan/Navigate-v0", "sensorplan/Recognize-v0"]
 N_BATCH = 256
@@ -140,7 +144,7 @@ def main(argv=None) -> None:
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--train", action="store_true", help="also time PPO training")
     ap.add_argument("--train-steps", type=int, default=20_480)
-    ap.add_argument("--out", default=str(Path(__file__).parent / "results" / "envs.md"))
+    _results.add_output_args(ap, "envs")
     args = ap.parse_args(argv)
     n = 500 if args.quick else 5000
     nv = 10 if args.quick else 60
@@ -158,34 +162,21 @@ def main(argv=None) -> None:
     rec_decl = batched_sps("sensorplan/Recognize-v0", nv, r, declare=True)
     nav_rand = batched_sps("sensorplan/Navigate-v0", nv, r, scene="random")
 
-    def ratio(v: float) -> str:
-        return f"{v / cart:.2f}x"
-
-    lines = [
-        "# Environment speed",
-        "",
-        f"Machine: {os.cpu_count()} cores, {platform.python_implementation()} "
-        f"{platform.python_version()}, numpy {np.__version__}, gymnasium {gym.__version__}.  "
-        f"Command: `python -m benchmarks.envs{' --train' if args.train else ''}`.  "
-        f"Medians of {r} chunks; load average at the end: {os.getloadavg()[0]:.1f}.",
-        "",
-        f"| env (random actions) | single env steps/s | ratio to CartPole | batched x{N_BATCH} "
-        "env-steps/s | ratio | batched grid obs | batched, numpy fallback |",
-        "| --- | ---: | ---: | ---: | ---: | ---: | ---: |",
-        f"| CartPole-v1 (anchor) | {cart:,.0f} | 1.00x | {cart_vec:,.0f} (CartPoleVectorEnv) | "
-        f"{ratio(cart_vec)} | | |",
-    ]
-    for env_id, s, b, g, npy in rows:
-        lines.append(
-            f"| {env_id} | {s:,.0f} | {ratio(s)} | {b:,.0f} | {ratio(b)} | {g:,.0f} | {npy:,.0f} |"
-        )
-    lines += [
-        "",
-        f"Batched Recognize-v0 with fully random actions (2/3 of the steps declare, so most "
-        f"steps are autoresets): {rec_decl:,.0f} env-steps/s ({ratio(rec_decl)}).  "
-        f'Batched Navigate-v0 on `scene="random"` (a pool of 64 scenes): {nav_rand:,.0f} '
-        f"env-steps/s ({ratio(nav_rand)}).",
-    ]
+    data: dict[str, Any] = {
+        "command": _results.command("benchmarks.envs", argv),
+        "machine": {**_results.machine(), "gymnasium": gym.__version__},
+        "repeats": r,
+        "n_batch": N_BATCH,
+        "cartpole": cart,
+        "cartpole_vector": cart_vec,
+        "rows": [
+            {"env": e, "single": s_, "batched": b, "batched_grid": g, "batched_numpy": npy}
+            for e, s_, b, g, npy in rows
+        ],
+        "recognize_declaring": rec_decl,
+        "navigate_random_scenes": nav_rand,
+        "train": None,
+    }
     if args.train:
         ts = args.train_steps
         rates = {
@@ -193,21 +184,67 @@ def main(argv=None) -> None:
             for v in ("batched", "dummy")
             for ne in (None, 64)
         }
+        data["train"] = {
+            "steps": ts,
+            "rows": [
+                {"vec_env": v, "shipped": rates[(v, None)], "envs64": rates[(v, 64)]}
+                for v in ("batched", "dummy")
+            ],
+        }
+    print(render(data))
+    _results.write("envs", data, args.out, args.update_results)
+
+
+def render(data: dict[str, Any]) -> str:
+    """The page fragment: env steps/s against CartPole-v1, and training throughput."""
+    cart = data["cartpole"]
+
+    def ratio(v: float) -> str:
+        return f"{v / cart:.2f}x"
+
+    nb = data["n_batch"]
+    lines = [
+        f"| env (random actions) | single env steps/s | ratio to CartPole | batched x{nb} "
+        "env-steps/s | ratio | batched grid obs | batched, numpy fallback |",
+        "| --- | ---: | ---: | ---: | ---: | ---: | ---: |",
+        f"| CartPole-v1 (anchor) | {cart:,.0f} | 1.00x | {data['cartpole_vector']:,.0f} "
+        f"(CartPoleVectorEnv) | {ratio(data['cartpole_vector'])} | | |",
+    ]
+    for r in data["rows"]:
+        lines.append(
+            f"| {r['env']} | {r['single']:,.0f} | {ratio(r['single'])} | {r['batched']:,.0f} | "
+            f"{ratio(r['batched'])} | {r['batched_grid']:,.0f} | {r['batched_numpy']:,.0f} |"
+        )
+    rd, nr = data["recognize_declaring"], data["navigate_random_scenes"]
+    lines += [
+        "",
+        f"Batched Recognize-v0 with fully random actions (2/3 of the steps declare, so most "
+        f"steps are autoresets): {rd:,.0f} env-steps/s ({ratio(rd)}).  "
+        f'Batched Navigate-v0 on `scene="random"` (a pool of 64 scenes): {nr:,.0f} '
+        f"env-steps/s ({ratio(nr)}).",
+    ]
+    if data.get("train"):
+        t = data["train"]
+        names = {"batched": "batched core (default)", "dummy": "SB3 DummyVecEnv"}
         lines += [
             "",
-            f"`sensorplan train` PPO on Navigate-v0, {ts:,} steps, 1 torch thread, wall clock "
-            "with updates (rollout of 2,048 steps, batch 128, 10 epochs, as shipped):",
+            f"`sensorplan train` PPO on Navigate-v0, {t['steps']:,} steps, 1 torch thread, "
+            "env-steps per second of wall clock with updates (rollout of 2,048 steps, batch "
+            "128, 10 epochs, as shipped):",
             "",
             "| vectorisation | shipped: 2 envs x 1,024 steps | 64 envs x 32 steps |",
             "| --- | ---: | ---: |",
         ]
-        for v, name in (("batched", "batched core (default)"), ("dummy", "SB3 DummyVecEnv")):
-            lines.append(f"| {name} | {rates[(v, None)]:,.0f} | {rates[(v, 64)]:,.0f} |")
-    text = "\n".join(lines) + "\n"
-    print(text)
-    out = Path(args.out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(text)
+        for row in t["rows"]:
+            lines.append(f"| {names[row['vec_env']]} | {row['shipped']:,.0f} | {row['envs64']:,.0f} |")
+    m = data["machine"]
+    lines += [
+        "",
+        f"`{data['command']}`: medians of {data['repeats']} chunks; {m['cpus']} CPUs, Python "
+        f"{m['python']}, numpy {m['numpy']}, gymnasium {m['gymnasium']}, load average "
+        f"{m['load_average']}.",
+    ]
+    return "\n".join(lines) + "\n"
 
 
 if __name__ == "__main__":
