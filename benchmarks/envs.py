@@ -236,7 +236,9 @@ def render(data: dict[str, Any]) -> str:
             "| --- | ---: | ---: |",
         ]
         for row in t["rows"]:
-            lines.append(f"| {names[row['vec_env']]} | {row['shipped']:,.0f} | {row['envs64']:,.0f} |")
+            lines.append(
+                f"| {names[row['vec_env']]} | {row['shipped']:,.0f} | {row['envs64']:,.0f} |"
+            )
     m = data["machine"]
     lines += [
         "",

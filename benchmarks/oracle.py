@@ -69,8 +69,13 @@ def main(argv: list[str] | None = None) -> None:
                 f"{wins / args.episodes:.3f} | 0 |"
             )
             data["rows"].append(
-                {"env": env_id, "scene": scene, "episodes": args.episodes, "successes": wins,
-                 "excluded": 0}
+                {
+                    "env": env_id,
+                    "scene": scene,
+                    "episodes": args.episodes,
+                    "successes": wins,
+                    "excluded": 0,
+                }
             )
             print(rows[-1], flush=True)
         rng = np.random.default_rng(SEED0)
@@ -91,8 +96,13 @@ def main(argv: list[str] | None = None) -> None:
             f"{wins / max(runs, 1):.3f} | {excluded} |"
         )
         data["rows"].append(
-            {"env": env_id, "scene": "random", "episodes": runs, "successes": wins,
-             "excluded": excluded}
+            {
+                "env": env_id,
+                "scene": "random",
+                "episodes": runs,
+                "successes": wins,
+                "excluded": excluded,
+            }
         )
         print(rows[-1], flush=True)
     table = "\n".join(rows)

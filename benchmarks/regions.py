@@ -199,7 +199,11 @@ def main(argv: list[str] | None = None) -> str:
                 iqrs.append(iqr)
             medians[(name, warm)] = meds
             data["rows"].append({"query": name, "warm": warm, "median_s": meds, "iqr_s": iqrs})
-            print(f"{'warm' if warm else 'cold'} {name}: " + ", ".join(f"{m * 1e3:.2f} ms" for m in meds), flush=True)
+            print(
+                f"{'warm' if warm else 'cold'} {name}: "
+                + ", ".join(f"{m * 1e3:.2f} ms" for m in meds),
+                flush=True,
+            )
     try:
         import pyvispoly  # noqa: F401
 
@@ -259,10 +263,16 @@ def render(data: dict[str, Any]) -> str:
     if g:
         i = edges.index(g["edges"])
         warm = next(r for r in data["rows"] if r["warm"] and r["query"] == "complete, stationary")
-        cold = next(r for r in data["rows"] if not r["warm"] and r["query"] == "complete, stationary")
+        cold = next(
+            r for r in data["rows"] if not r["warm"] and r["query"] == "complete, stationary"
+        )
         scale = (100 * 100) / (g["grid"] ** 2)
         est = g["seconds"] * scale
-        how = "measured" if g["grid"] == 100 else f"measured on a {g['grid']}x{g['grid']} grid, scaled"
+        how = (
+            "measured"
+            if g["grid"] == 100
+            else f"measured on a {g['grid']}x{g['grid']} grid, scaled"
+        )
         lines += [
             "",
             "Without this package: classifying a 100 x 100 grid of placements with pyvispoly "

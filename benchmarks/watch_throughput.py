@@ -115,9 +115,7 @@ def render(data: dict[str, Any]) -> str:
     for r in data["rows"]:
         sps = steps / r["median_s"]
         n = r["agents"]
-        lines.append(
-            f"| {r['env']} | {sps:,.0f} | {n} | {sps * n:,.0f} | {sps * n / anchor:.2f} |"
-        )
+        lines.append(f"| {r['env']} | {sps:,.0f} | {n} | {sps * n:,.0f} | {sps * n / anchor:.2f} |")
     m = data["machine"]
     lines += [
         "",

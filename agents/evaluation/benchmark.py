@@ -33,7 +33,7 @@ from pathlib import Path
 from typing import Any
 
 from ..learning.policies import make_env
-from .evaluate import evaluate
+from .evaluate import evaluate, fresh_dir
 
 __all__ = ["DEFAULT_DIFFICULTY", "TEST_POOL_SEED", "TRAIN_POOL_SEED", "benchmark", "splits"]
 
@@ -109,7 +109,11 @@ def benchmark(
     needs_start = bool(probe.unwrapped.batch.needs_start)
     probe.close()
     sp = splits(split_names or ["train", "test", "ood"], difficulty, needs_start)
-    out = Path(out) if out is not None else Path("runs") / f"benchmark_{env_id.split('/')[-1]}"
+    out = (
+        Path(out)
+        if out is not None
+        else fresh_dir(Path("runs") / f"benchmark_{env_id.split('/')[-1]}")
+    )
     out.mkdir(parents=True, exist_ok=True)
     res: dict[str, Any] = {
         "env_id": env_id,
