@@ -119,7 +119,8 @@ def write(name: str, data: dict[str, Any], out: Path, update_results: bool) -> l
         try:
             p.parent.mkdir(parents=True, exist_ok=True)
         except OSError as e:
-            raise SystemExit(f"cannot create the output folder {p.parent}: {e.strerror or e}")
+            msg = f"cannot create the output folder {p.parent}: {e.strerror or e}"
+            raise SystemExit(msg) from None
     paths[0].write_text(json.dumps(data, indent=1, ensure_ascii=False) + "\n", encoding="utf-8")
     paths[1].write_text(render(name, data), encoding="utf-8")
     print(f"wrote {paths[0]} and {paths[1]}")

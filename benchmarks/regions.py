@@ -239,7 +239,8 @@ def render(data: dict[str, Any]) -> str:
             "",
             "**Warm** (repeated queries on one loaded Scene):"
             if warm
-            else "**Cold** (first query on a freshly loaded Scene, building its visibility domain):",
+            else "**Cold** (first query on a freshly loaded Scene, building its visibility "
+            "domain):",
             "",
             "| query | " + " | ".join(f"{n} edges" for n in edges) + " | growth (log-log slope) |",
             "| --- |" + " ---: |" * (len(edges) + 1),
@@ -276,7 +277,8 @@ def render(data: dict[str, Any]) -> str:
         lines += [
             "",
             "Without this package: classifying a 100 x 100 grid of placements with pyvispoly "
-            f"(CGAL) visibility polygons for the stationary complete query on the {g['edges']}-edge "
+            "(CGAL) visibility polygons for the stationary complete query on the "
+            f"{g['edges']}-edge "
             f"scene takes {est:.2f} s ({how}), {est / warm['median_s'][i]:,.0f} x the warm exact "
             f"query and {est / cold['median_s'][i]:,.0f} x the cold one, and gives only a raster.",
         ]
