@@ -5,8 +5,9 @@ Run ``python -m benchmarks.swept_accuracy [--seeds FIRST LAST]`` (default 0 10; 
 (default ``runs/benchmarks/swept_accuracy/``), or with ``--update-results`` to the tracked
 ``benchmarks/results/swept_accuracy.json`` and ``docs/results/swept_accuracy.md``.
 
-For random scenes with a polygonal G it compares the union of the swept shadows (:func:`geometry.sweep.swept_shadows`) with the union of 201 exact stationary shadows
-per edge of G (a subset of the true union):
+For random scenes with a polygonal G it compares the union of the swept shadows
+(:func:`geometry.sweep.swept_shadows`) with the union of 201 exact stationary shadows per edge
+of G (a subset of the true union):
 
 * *missed*: area of the reference not in the sweep (the region would be too large), and the
   depth of the deepest missed sliver (``shapely.minimum_clearance``);
