@@ -89,3 +89,14 @@ def test_benchmarks_write_to_out_by_default(tmp_path, monkeypatch):
 def test_command_drops_the_output_options():
     cmd = _results.command("benchmarks.envs", ["--train", "--out", "x", "--update-results"])
     assert cmd == "python -m benchmarks.envs --train"
+
+
+def test_reference_with_nothing_to_do_says_so(tmp_path, monkeypatch, capsys):
+    from benchmarks import reference
+
+    monkeypatch.chdir(tmp_path)
+    assert reference.main(["evaluate"]) == 1
+    assert "nothing to evaluate" in capsys.readouterr().out
+    assert reference.main(["report"]) == 1
+    assert "nothing to report" in capsys.readouterr().out
+    assert not (tmp_path / "runs" / "benchmarks").exists()
