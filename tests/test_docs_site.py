@@ -100,3 +100,25 @@ def test_api_page_renders_the_docstrings(site, tmp_path):
     page = _dom(tmp_path, base + "geometry-api/")
     for name in ("complete_region", "partial_region", "recognizable_region", "Scene"):
         assert f'id="geometry.{name}"' in page, f"no API entry for geometry.{name}"
+
+
+def test_environment_figure_is_painted(site, tmp_path):
+    """A screenshot of the environment page shows the figure: the renderer's grey frame
+    (RGB 153, 153, 153) covers a large patch of the page, which without the image is white."""
+    import numpy as np
+    from PIL import Image
+
+    base, _, _ = site
+    shot = tmp_path / "navigate.png"
+    r = chromium(
+        tmp_path,
+        "--window-size=1280,1000",
+        "--virtual-time-budget=5000",
+        f"--screenshot={shot}",
+        base + "environments/navigate/",
+        timeout=90,
+    )
+    assert r.returncode == 0 and shot.is_file(), r.stderr[-2000:]
+    img = np.asarray(Image.open(shot).convert("RGB")).astype(int)
+    grey = (np.abs(img - 153).max(axis=2) <= 6).sum()
+    assert grey > 20_000, f"the figure is not painted ({grey} grey pixels)"
