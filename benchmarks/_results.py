@@ -36,6 +36,7 @@ DEFAULT_OUT = Path("runs") / "benchmarks"
 NAMES = (
     "envs",
     "oracle",
+    "policies",
     "regions",
     "scaling",
     "swept",
