@@ -41,6 +41,7 @@ NAMES = (
     "scaling",
     "swept",
     "swept_accuracy",
+    "viewer_layers",
     "watch_oracle",
     "watch_throughput",
     "reference",
