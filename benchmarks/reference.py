@@ -323,15 +323,14 @@ def evaluate_grid(
     envs: list[str] | None = None,
     only: list[Entry] | None = None,
     new: bool = False,
-) -> int:
+) -> None:
     """``sensorplan benchmark`` per env (and per action type) with every trained model;
     ``envs``: only these env ids.  ``only``: only these entries' models, without the
     baselines, into ``<group>/models-<entry>/`` (:func:`report` merges them; a model's
     episodes do not depend on which other policies are evaluated with it); ``new``: only
-    models not evaluated yet.  Returns the number of models evaluated."""
+    models not evaluated yet."""
     from agents.evaluation.benchmark import benchmark
 
-    n_models = 0
     for env_id in envs or (PLACE, REC, NAV):
         for discrete in (False, True):
             entries = [e for e in GRID if e.env_id == env_id and e.discrete == discrete]
@@ -340,7 +339,6 @@ def evaluate_grid(
             if only is None and not new:
                 models = _models(entries)
                 if models:
-                    n_models += len(models)
                     base = ["random"] if discrete else ["oracle", "random"]
                     benchmark(
                         env_id,
@@ -356,7 +354,6 @@ def evaluate_grid(
                     continue
                 models = [m for m in _models([e]) if m not in done]
                 if models:
-                    n_models += len(models)
                     benchmark(
                         env_id,
                         models,
@@ -365,7 +362,6 @@ def evaluate_grid(
                         env_kwargs=kw,
                         out=_models_dir(_group_dir(env_id, discrete), e.key, new),
                     )
-    return n_models
 
 
 def _models_dir(group: Path, key: str, new: bool) -> Path:
@@ -549,16 +545,12 @@ def main(argv: list[str] | None = None) -> int:
             return 0
         train_grid(entries, args.seeds)
     elif args.cmd == "evaluate":
-        n = evaluate_grid(
+        evaluate_grid(
             args.episodes,
             envs=args.envs,
             only=_selected(args.only) if args.only else None,
             new=args.new,
         )
-        if n == 0:
-            what = "model not evaluated yet" if args.new else "trained model"
-            print(f"nothing to evaluate: no {what} under {RUNS}/ (run `train` first)")
-            return 1
     else:
         data = {"command": _results.command("benchmarks.reference", argv), **report_data()}
         if not data["envs"]:

@@ -1,6 +1,6 @@
 """How close the swept partial region comes to a dense reference (paper 3.2.2-3.2.3).
 
-Run ``python -m benchmarks.swept_accuracy [--seeds FIRST LAST]`` (default 0 10; about
+Run ``python -m benchmarks.swept_accuracy [first_seed] [last_seed]`` (default 0 10; about
 30 s a scene).  The data (``swept_accuracy.json``) and the page fragment go to ``--out``
 (default ``runs/benchmarks/swept_accuracy/``), or with ``--update-results`` to the tracked
 ``benchmarks/results/swept_accuracy.json`` and ``docs/results/swept_accuracy.md``.
@@ -36,10 +36,11 @@ def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(
         prog="python -m benchmarks.swept_accuracy", description=__doc__.split("\n\n")[0]
     )
-    ap.add_argument("--seeds", type=int, nargs=2, default=[0, 10], metavar=("FIRST", "LAST"))
+    ap.add_argument("first_seed", nargs="?", type=int, default=0, help="default 0")
+    ap.add_argument("last_seed", nargs="?", type=int, default=10, help="default 10")
     _results.add_output_args(ap, "swept_accuracy")
     args = ap.parse_args(argv)
-    first, last = args.seeds
+    first, last = args.first_seed, args.last_seed
     data: dict[str, Any] = {
         "command": _results.command("benchmarks.swept_accuracy", argv),
         "machine": _results.machine(),

@@ -91,12 +91,13 @@ def test_command_drops_the_output_options():
     assert cmd == "python -m benchmarks.envs --train"
 
 
-def test_reference_with_nothing_to_do_says_so(tmp_path, monkeypatch, capsys):
+def test_reference_report_with_nothing_to_do_says_so(tmp_path, monkeypatch, capsys):
     from benchmarks import reference
 
     monkeypatch.chdir(tmp_path)
-    assert reference.main(["evaluate"]) == 1
-    assert "nothing to evaluate" in capsys.readouterr().out
-    assert reference.main(["report"]) == 1
+    reference.main(["report", "--update-results"])
     assert "nothing to report" in capsys.readouterr().out
     assert not (tmp_path / "runs" / "benchmarks").exists()
+    assert (ROOT / "docs" / "results" / "reference.md").read_text(encoding="utf-8") == (
+        _results.render("reference", _results.load("reference"))
+    )
