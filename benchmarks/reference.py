@@ -47,6 +47,8 @@ REC = "sensorplan/Recognize-v0"
 PLACE = "sensorplan/Placement-v0"
 RUNS = Path("runs")
 OUT = RUNS / "reference"
+#: the tracked page fragment (with its data, benchmarks/results/reference.json)
+TRACKED = _results.FRAGMENT_DIR / "reference.md"
 SEEDS = (0, 1, 2, 3, 4)
 
 #: training env kwargs per env: the procedural train pool at the benchmark's difficulty
@@ -554,7 +556,12 @@ def main(argv: list[str] | None = None) -> int:
     else:
         data = {"command": _results.command("benchmarks.reference", argv), **report_data()}
         if not data["envs"]:
-            print(f"nothing to report: no evaluated model under {OUT} (run `evaluate` first)")
+            print(
+                f"nothing to report: no benchmark results under {OUT}/; evaluate the trained "
+                f"models first with: python -m benchmarks.reference evaluate"
+                + (f" ({TRACKED} left as it is)" if args.update_results else ""),
+                file=sys.stderr,
+            )
             return 1
         print(render(data))
         _results.write("reference", data, args.out, args.update_results)
