@@ -155,7 +155,11 @@ def build_parser() -> argparse.ArgumentParser:
         default=None,
         help="JSON gym.make kwargs for the evaluation env",
     )
-    e.add_argument("--out", default=None, help="output folder (default runs/eval_<env>_s<seed>)")
+    e.add_argument(
+        "--out",
+        default=None,
+        help="output folder (default runs/eval_<env>_s<seed>; .2, .3, ... appended when it exists)",
+    )
     e.add_argument("--no-plot", action="store_true")
     e.add_argument(
         "--backend",
@@ -194,7 +198,11 @@ def build_parser() -> argparse.ArgumentParser:
         "--splits", nargs="+", default=None, help="train, test, ood, ood:<scene> (default: all)"
     )
     bm.add_argument("--env-kwargs", type=_json_dict, default=None)
-    bm.add_argument("--out", default=None, help="output folder (default runs/benchmark_<env>)")
+    bm.add_argument(
+        "--out",
+        default=None,
+        help="output folder (default runs/benchmark_<env>; .2, .3, ... appended when it exists)",
+    )
     bm.add_argument(
         "--stochastic",
         action="store_true",

@@ -2,7 +2,9 @@
 
     python -m benchmarks.envs [--quick] [--train]
 
-Writes a markdown table to ``benchmarks/results/envs.md`` (and prints it).
+Prints the table and writes the data (``envs.json``) and the page fragment (``envs.md``) to
+``--out`` (default ``runs/benchmarks/envs/``), or with ``--update-results`` to the tracked
+``benchmarks/results/envs.json`` and ``docs/results/envs.md``.
 
 * **single env**: ``gym.make(id)`` with its standard wrappers, random actions drawn up front,
   resets included when an episode ends; CartPole-v1 the same way.
@@ -29,18 +31,20 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import platform
 import subprocess
 import sys
 import tempfile
 import time
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import gymnasium as gym
 import numpy as np
 
 import sensorplan_gym  # noqa: F401
+
+from . import _results
 
 IDS = ["sensorplan/Placement-v0", "sensorplan/Navigate-v0", "sensorplan/Recognize-v0"]
 N_BATCH = 256
@@ -210,7 +214,7 @@ def main(argv=None) -> None:
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--train", action="store_true", help="also time PPO training")
     ap.add_argument("--train-steps", type=int, default=20_480)
-    ap.add_argument("--out", default=str(Path(__file__).parent / "results" / "envs.md"))
+    _results.add_output_args(ap, "envs")
     args = ap.parse_args(argv)
     n = 500 if args.quick else 5000
     nv = 10 if args.quick else 60
@@ -245,42 +249,30 @@ def main(argv=None) -> None:
     cart = float(np.median(c_log))
     cart_vec = float(np.median(v_log))
 
-    def ratio(v: float) -> str:
-        return f"{v / cart:.2f}x"
-
-    def ex(name: str) -> str:
-        return f"{extra[name][1]:,.0f} env-steps/s ({extra[name][2]:.2f}x)"
-
-    lines = [
-        "# Environment speed",
-        "",
-        f"Machine: {os.cpu_count()} cores, {platform.python_implementation()} "
-        f"{platform.python_version()}, numpy {np.__version__}, gymnasium {gym.__version__}.  "
-        f"Command: `python -m benchmarks.envs{' --train' if args.train else ''}`.  "
-        f"Medians of {r} chunks of about {CHUNK_SECONDS} s; every ratio is the median of {r} "
-        f"ratios of chunks timed alternately with the anchor's (the load changes alike for "
-        f"both); load average at "
-        f"the end: {os.getloadavg()[0]:.1f}.",
-        "",
-        f"| env (random actions) | single env steps/s | ratio to CartPole | batched x{N_BATCH} "
-        "env-steps/s | ratio to CartPole | ratio to CartPoleVectorEnv | batched grid obs "
-        "| batched, numpy fallback |",
-        "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |",
-        f"| CartPole-v1 (anchor) | {cart:,.0f} | 1.00x | {cart_vec:,.0f} (CartPoleVectorEnv) | "
-        f"{ratio(cart_vec)} | 1.00x | | |",
-    ]
-    for env_id, s, rs, b, rb, rv, g, npy in rows:
-        lines.append(
-            f"| {env_id} | {s:,.0f} | {rs:.2f}x | {b:,.0f} | {rb:.2f}x | "
-            f"{rv:.3f}x | {g:,.0f} | {npy:,.0f} |"
-        )
-    lines += [
-        "",
-        "Batched Recognize-v0 with fully random actions (2/3 of the steps declare, so most "
-        f'steps are autoresets): {ex("rec_decl")}; on `scene="random"` (a pool of 64 '
-        f"scenes, a new scene at most resets): {ex('rec_decl_rand')}.  Batched Navigate-v0 "
-        f'on `scene="random"`: {ex("nav_rand")}.  Ratios to CartPole-v1 single.',
-    ]
+    data: dict[str, Any] = {
+        "command": _results.command("benchmarks.envs", argv),
+        "machine": {**_results.machine(), "gymnasium": gym.__version__},
+        "repeats": r,
+        "chunk_seconds": CHUNK_SECONDS,
+        "n_batch": N_BATCH,
+        "cartpole": cart,
+        "cartpole_vector": cart_vec,
+        "rows": [
+            {
+                "env": e,
+                "single": s_,
+                "ratio_single": rs,
+                "batched": b,
+                "ratio_batched": rb,
+                "ratio_vector": rv,
+                "batched_grid": g,
+                "batched_numpy": npy,
+            }
+            for e, s_, rs, b, rb, rv, g, npy in rows
+        ],
+        "extra": {k: {"rate": v[1], "ratio": v[2]} for k, v in extra.items()},
+        "train": None,
+    }
     if args.train:
         ts = args.train_steps
         rates = {
@@ -288,21 +280,74 @@ def main(argv=None) -> None:
             for v in ("batched", "dummy")
             for ne in (None, 64)
         }
+        data["train"] = {
+            "steps": ts,
+            "rows": [
+                {"vec_env": v, "shipped": rates[(v, None)], "envs64": rates[(v, 64)]}
+                for v in ("batched", "dummy")
+            ],
+        }
+    print(render(data))
+    _results.write("envs", data, args.out, args.update_results)
+
+
+def render(data: dict[str, Any]) -> str:
+    """The page fragment: env steps/s against CartPole-v1 and CartPoleVectorEnv (each
+    ratio the median of paired chunk ratios), and training throughput."""
+    cart = data["cartpole"]
+    nb = data["n_batch"]
+    lines = [
+        f"| env (random actions) | single env steps/s | ratio to CartPole | batched x{nb} "
+        "env-steps/s | ratio to CartPole | ratio to CartPoleVectorEnv | batched grid obs "
+        "| batched, numpy fallback |",
+        "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |",
+        f"| CartPole-v1 (anchor) | {cart:,.0f} | 1.00x | {data['cartpole_vector']:,.0f} "
+        f"(CartPoleVectorEnv) | {data['cartpole_vector'] / cart:.2f}x | 1.00x | | |",
+    ]
+    for r in data["rows"]:
+        lines.append(
+            f"| {r['env']} | {r['single']:,.0f} | {r['ratio_single']:.2f}x | "
+            f"{r['batched']:,.0f} | {r['ratio_batched']:.2f}x | {r['ratio_vector']:.3f}x | "
+            f"{r['batched_grid']:,.0f} | {r['batched_numpy']:,.0f} |"
+        )
+
+    def ex(name: str) -> str:
+        x = data["extra"][name]
+        return f"{x['rate']:,.0f} env-steps/s ({x['ratio']:.2f}x)"
+
+    lines += [
+        "",
+        "Batched Recognize-v0 with fully random actions (2/3 of the steps declare, so most "
+        f'steps are autoresets): {ex("rec_decl")}; on `scene="random"` (a pool of 64 '
+        f"scenes, a new scene at most resets): {ex('rec_decl_rand')}.  Batched Navigate-v0 "
+        f'on `scene="random"`: {ex("nav_rand")}.  Ratios to CartPole-v1 single.',
+    ]
+    if data.get("train"):
+        t = data["train"]
+        names = {"batched": "batched core (default)", "dummy": "SB3 DummyVecEnv"}
         lines += [
             "",
-            f"`sensorplan train` PPO on Navigate-v0, {ts:,} steps, 1 torch thread, wall clock "
-            "with updates (rollout of 2,048 steps, batch 128, 10 epochs, as shipped):",
+            f"`sensorplan train` PPO on Navigate-v0, {t['steps']:,} steps, 1 torch thread, "
+            "env-steps per second of wall clock with updates (rollout of 2,048 steps, batch "
+            "128, 10 epochs, as shipped):",
             "",
             "| vectorisation | shipped: 2 envs x 1,024 steps | 64 envs x 32 steps |",
             "| --- | ---: | ---: |",
         ]
-        for v, name in (("batched", "batched core (default)"), ("dummy", "SB3 DummyVecEnv")):
-            lines.append(f"| {name} | {rates[(v, None)]:,.0f} | {rates[(v, 64)]:,.0f} |")
-    text = "\n".join(lines) + "\n"
-    print(text)
-    out = Path(args.out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(text)
+        for row in t["rows"]:
+            lines.append(
+                f"| {names[row['vec_env']]} | {row['shipped']:,.0f} | {row['envs64']:,.0f} |"
+            )
+    m = data["machine"]
+    lines += [
+        "",
+        f"`{data['command']}`: medians of {data['repeats']} chunks of about "
+        f"{data['chunk_seconds']} s, each ratio the median of the ratios of chunks timed "
+        f"alternately with the anchor's; {m['cpus']} CPUs, Python "
+        f"{m['python']}, numpy {m['numpy']}, gymnasium {m['gymnasium']}, load average "
+        f"{m['load_average']}.",
+    ]
+    return "\n".join(lines) + "\n"
 
 
 if __name__ == "__main__":

@@ -4,16 +4,16 @@ For every environment, every bundled scene (N episodes each, evaluation seeds
 1_000_000 onwards) and M procedural scenes (``geometry.generate.random_scene``, one
 episode each).  A random scene whose recognizable region is empty, or not reachable
 from any start, has no recognizing placement: it is excluded from the rate and counted
-separately.  Prints a markdown table and writes it to ``--out`` (default
-``runs/benchmarks/oracle.md``); the tracked ``benchmarks/results/oracle.md`` is
-rewritten only with ``--update-results``.
+separately.  Prints the table and writes the data (``oracle.json``) and the page fragment
+(``oracle.md``) to ``--out`` (default ``runs/benchmarks/oracle/``); with ``--update-results``
+the tracked ``benchmarks/results/oracle.json`` and ``docs/results/oracle.md`` instead.
 """
 
 from __future__ import annotations
 
 import argparse
 import time
-from pathlib import Path
+from typing import Any
 
 import gymnasium as gym
 import numpy as np
@@ -22,13 +22,11 @@ import sensorplan_gym  # noqa: F401
 from agents.planning.oracle import OraclePolicy
 from geometry.generate import random_scene
 
+from . import _results
+
 ENVS = ["sensorplan/Placement-v0", "sensorplan/Navigate-v0", "sensorplan/Recognize-v0"]
 SCENES = ["lab", "edr", "corridor", "warehouse"]
 SEED0 = 1_000_000
-#: the tracked results file (rewritten only with --update-results)
-TRACKED = Path(__file__).parent / "results" / "oracle.md"
-#: where a run writes by default (runs/ is git-ignored)
-DEFAULT_OUT = Path("runs") / "benchmarks" / "oracle.md"
 
 
 def episode(env, policy, seed: int) -> bool:
@@ -48,18 +46,16 @@ def main(argv: list[str] | None = None) -> None:
     )
     ap.add_argument("--episodes", type=int, default=100)
     ap.add_argument("--random-scenes", type=int, default=200)
-    ap.add_argument(
-        "--out",
-        type=Path,
-        default=DEFAULT_OUT,
-        help=f"markdown file for the table (default {DEFAULT_OUT})",
-    )
-    ap.add_argument(
-        "--update-results",
-        action="store_true",
-        help=f"write the tracked {TRACKED} instead of --out",
-    )
+    _results.add_output_args(ap, "oracle")
     args = ap.parse_args(argv)
+    data: dict[str, Any] = {
+        "command": _results.command("benchmarks.oracle", argv),
+        "machine": _results.machine(),
+        "episodes": args.episodes,
+        "random_scenes": args.random_scenes,
+        "seed0": SEED0,
+        "rows": [],
+    }
     rows = [
         "| env | scene | episodes | successes | success rate | excluded (no placement) |",
         "| --- | --- | ---: | ---: | ---: | ---: |",
@@ -73,6 +69,15 @@ def main(argv: list[str] | None = None) -> None:
             rows.append(
                 f"| {env_id} | {scene} | {args.episodes} | {wins} | "
                 f"{wins / args.episodes:.3f} | 0 |"
+            )
+            data["rows"].append(
+                {
+                    "env": env_id,
+                    "scene": scene,
+                    "episodes": args.episodes,
+                    "successes": wins,
+                    "excluded": 0,
+                }
             )
             print(rows[-1], flush=True)
         rng = np.random.default_rng(SEED0)
@@ -92,12 +97,60 @@ def main(argv: list[str] | None = None) -> None:
             f"| {env_id} | random ({args.random_scenes} scenes) | {runs} | {wins} | "
             f"{wins / max(runs, 1):.3f} | {excluded} |"
         )
+        data["rows"].append(
+            {
+                "env": env_id,
+                "scene": "random",
+                "episodes": runs,
+                "successes": wins,
+                "excluded": excluded,
+            }
+        )
         print(rows[-1], flush=True)
     table = "\n".join(rows)
-    out = TRACKED if args.update_results else args.out
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text("# Oracle success (`python -m benchmarks.oracle`)\n\n" + table + "\n")
-    print(f"\n{table}\n\n({time.perf_counter() - t0:.0f} s; written to {out})")
+    data["seconds"] = round(time.perf_counter() - t0, 1)
+    print(f"\n{table}\n\n({data['seconds']:.0f} s)")
+    _results.write("oracle", data, args.out, args.update_results)
+
+
+def render(data: dict[str, Any]) -> str:
+    """The page fragment: successes / episodes per env and scene."""
+    scenes: list[str] = []
+    by: dict[tuple[str, str], dict] = {}
+    for r in data["rows"]:
+        if r["scene"] not in scenes:
+            scenes.append(r["scene"])
+        by[(r["env"], r["scene"])] = r
+    envs = list(dict.fromkeys(r["env"] for r in data["rows"]))
+
+    def head(sc: str) -> str:
+        return f"{data['random_scenes']} random scenes" if sc == "random" else sc
+
+    lines = [
+        "| oracle success | " + " | ".join(head(sc) for sc in scenes) + " |",
+        "| --- |" + " ---: |" * len(scenes),
+    ]
+    for env in envs:
+        cells = []
+        for sc in scenes:
+            r = by.get((env, sc))
+            if r is None:
+                cells.append("")
+                continue
+            c = f"{r['successes']}/{r['episodes']}"
+            if sc == "random":
+                c += f" ({r['excluded']} without a placement)"
+            cells.append(c)
+        lines.append(f"| {env.split('/')[-1]} | " + " | ".join(cells) + " |")
+    m = data["machine"]
+    lines += [
+        "",
+        f"`{data['command']}`: {data['episodes']} episodes per bundled scene (seeds "
+        f"{data['seed0']:,} onwards), one episode on each of {data['random_scenes']} procedural "
+        f"scenes; {data['seconds']:,.0f} s on {m['cpus']} CPUs (load average "
+        f"{m['load_average']}).",
+    ]
+    return "\n".join(lines) + "\n"
 
 
 if __name__ == "__main__":

@@ -18,8 +18,10 @@
     the markdown table per env: success per split, the interquartile mean over training seeds
     with its stratified-bootstrap 95 % interval (:mod:`agents.evaluation.stats`), the normalized
     score ``(agent - random) / (oracle - random)`` on the test split and, for Navigate, the mean
-    path length over the oracle's.  Written to ``runs/reference/reference.md``; the tracked
-    ``benchmarks/results/reference.md`` only with ``--update-results``.
+    path length over the oracle's.  The table's data (``reference.json``) and the page fragment
+    (``reference.md``) go to ``--out`` (default ``runs/benchmarks/reference/``), or with
+    ``--update-results`` to the tracked ``benchmarks/results/reference.json`` and
+    ``docs/results/reference.md``.  With no evaluated model it says so and writes nothing.
 
 Discrete-action agents (DQN) play the envs with ``action_type="discrete"``, where the
 analytic oracle does not run: their normalized score uses the oracle's success from the
@@ -38,12 +40,15 @@ from typing import Any
 
 import numpy as np
 
+from . import _results
+
 NAV = "sensorplan/Navigate-v0"
 REC = "sensorplan/Recognize-v0"
 PLACE = "sensorplan/Placement-v0"
 RUNS = Path("runs")
 OUT = RUNS / "reference"
-TRACKED = Path(__file__).parent / "results" / "reference.md"
+#: the tracked page fragment (with its data, benchmarks/results/reference.json)
+TRACKED = _results.FRAGMENT_DIR / "reference.md"
 SEEDS = (0, 1, 2, 3, 4)
 
 #: training env kwargs per env: the procedural train pool at the benchmark's difficulty
@@ -379,22 +384,33 @@ def _models_dir(group: Path, key: str, new: bool) -> Path:
     return d
 
 
-def _cell(rates: list[float], seed: int = 0) -> str:
+def _cell(rates: list[float], seed: int = 0) -> dict[str, Any] | None:
+    """The IQM over training seeds with its stratified-bootstrap 95 % interval (``n`` seeds);
+    one seed: its value; none: ``None``."""
     from agents.evaluation.stats import iqm, stratified_bootstrap_ci
 
     if not rates:
-        return "—"
+        return None
     if len(rates) == 1:
-        return f"{rates[0]:.2f} (1 seed)"
+        return {"n": 1, "est": float(rates[0])}
     est, lo, hi = stratified_bootstrap_ci(np.array([[r] for r in rates]), iqm, seed=seed)
-    return f"{est:.2f} [{lo:.2f}, {hi:.2f}]"
+    return {"n": len(rates), "est": float(est), "lo": float(lo), "hi": float(hi)}
 
 
-def report() -> str:
-    """The markdown tables of the evaluated grid."""
+def _fmt_cell(c: dict[str, Any] | None) -> str:
+    if c is None:
+        return "—"
+    if c["n"] == 1:
+        return f"{c['est']:.2f} (1 seed)"
+    return f"{c['est']:.2f} [{c['lo']:.2f}, {c['hi']:.2f}]"
+
+
+def report_data() -> dict[str, Any]:
+    """The tables' data of the evaluated grid (``runs/reference``): per env the splits and one
+    row per baseline and per grid entry."""
     from agents.learning.policies import model_config
 
-    out = []
+    out: dict[str, Any] = {"envs": []}
     for env_id in (PLACE, REC, NAV):
         rows: dict[str, dict] = {}
         splits: list[str] = []
@@ -435,44 +451,81 @@ def report() -> str:
                     row.setdefault(f"path:{sp}", []).append(p["mean_path_length"])
         if not rows:
             continue
-        short = env_id.split("/")[-1]
-        head = ["agent", "seeds", "train time / seed", *splits, "normalized (test)"]
-        if env_id == NAV:
-            head.append("path / oracle (test)")
-        lines = [f"**{short}**", "", "| " + " | ".join(head) + " |"]
-        lines.append("| " + " | ".join(["---"] * len(head)) + " |")
+        table: dict[str, Any] = {"env": env_id.split("/")[-1], "splits": splits, "rows": []}
         for label, row in rows.items():
             if label in ("oracle", "random", "random (discrete)"):
-                cells = [
-                    label,
-                    "—",
-                    "—",
-                    *(f"{base.get((label, sp), float('nan')):.2f}" for sp in splits),
-                ]
-                cells.append("1.00" if label == "oracle" else "0.00")
-                if env_id == NAV:
-                    o = path.get(("oracle", "test"))
-                    p_ = path.get((label, "test"))
-                    cells.append(f"{p_ / o:.2f}" if o and p_ is not None else "—")
-                lines.append("| " + " | ".join(cells) + " |")
+                o = path.get(("oracle", "test"))
+                p_ = path.get((label, "test"))
+                table["rows"].append(
+                    {
+                        "label": label,
+                        "baseline": True,
+                        "success": {sp: base.get((label, sp)) for sp in splits},
+                        "normalized": 1.0 if label == "oracle" else 0.0,
+                        "path_ratio": p_ / o if o and p_ is not None else None,
+                    }
+                )
                 continue
             rnd = "random (discrete)" if row["discrete"] else "random"
-            n = len(row["runs"])
             times = [t for t in row.get("time", []) if t is not None]
-            wall = f"{np.median(times) / 60:.1f} min" if times else "—"
-            cells = [label, str(n), wall, *(_cell(row.get(sp, [])) for sp in splits)]
             o, r0 = base.get(("oracle", "test"), 1.0), base.get((rnd, "test"))
+            norm = None
             if r0 is not None and o > r0 and row.get("test"):
-                cells.append(_cell([(x - r0) / (o - r0) for x in row["test"]]))
+                norm = _cell([(x - r0) / (o - r0) for x in row["test"]])
+            op = path.get(("oracle", "test"))
+            ps = row.get("path:test", [])
+            table["rows"].append(
+                {
+                    "label": label,
+                    "baseline": False,
+                    "seeds": len(row["runs"]),
+                    "train_min": float(np.median(times) / 60) if times else None,
+                    "success": {sp: _cell(row.get(sp, [])) for sp in splits},
+                    "normalized": norm,
+                    "path_ratio": float(np.median(ps) / op) if op and ps else None,
+                }
+            )
+        out["envs"].append(table)
+    return out
+
+
+def render(data: dict[str, Any]) -> str:
+    """The markdown table per env of :func:`report_data`'s data."""
+    out = []
+    for t in data["envs"]:
+        nav = t["env"] == NAV.split("/")[-1]
+        splits = t["splits"]
+        head = ["agent", "seeds", "train time / seed", *splits, "normalized (test)"]
+        if nav:
+            head.append("path / oracle (test)")
+        lines = [f"**{t['env']}**", "", "| " + " | ".join(head) + " |"]
+        lines.append("| " + " | ".join(["---"] * len(head)) + " |")
+        for r in t["rows"]:
+            if r["baseline"]:
+                cells = [r["label"], "—", "—"]
+                cells += [
+                    "nan" if r["success"].get(sp) is None else f"{r['success'][sp]:.2f}"
+                    for sp in splits
+                ]
+                cells.append(f"{r['normalized']:.2f}")
+                if nav:
+                    cells.append("—" if r["path_ratio"] is None else f"{r['path_ratio']:.2f}")
             else:
-                cells.append("—")
-            if env_id == NAV:
-                op = path.get(("oracle", "test"))
-                ps = row.get("path:test", [])
-                cells.append(f"{np.median(ps) / op:.2f} (median of seeds)" if op and ps else "—")
+                wall = "—" if r["train_min"] is None else f"{r['train_min']:.1f} min"
+                cells = [r["label"], str(r["seeds"]), wall]
+                cells += [_fmt_cell(r["success"].get(sp)) for sp in splits]
+                cells.append(_fmt_cell(r["normalized"]))
+                if nav:
+                    pr = r["path_ratio"]
+                    cells.append("—" if pr is None else f"{pr:.2f} (median of seeds)")
             lines.append("| " + " | ".join(cells) + " |")
         out.append("\n".join(lines))
     return "\n\n".join(out) + "\n"
+
+
+def report() -> str:
+    """The markdown tables of the evaluated grid."""
+    return render(report_data())
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -490,7 +543,7 @@ def main(argv: list[str] | None = None) -> int:
     )
     ev.add_argument("--new", action="store_true", help="only models not evaluated yet")
     rp = sub.add_parser("report", help="the markdown tables")
-    rp.add_argument("--update-results", action="store_true")
+    _results.add_output_args(rp, "reference")
     args = ap.parse_args(argv)
     if args.cmd == "train":
         entries = _selected(args.only)
@@ -519,8 +572,8 @@ def main(argv: list[str] | None = None) -> int:
                 f"have results under {OUT}/ (without --new every model is evaluated again)"
             )
     else:
-        text = report()
-        if not text.strip():
+        data = {"command": _results.command("benchmarks.reference", argv), **report_data()}
+        if not data["envs"]:
             print(
                 f"nothing to report: no benchmark results under {OUT}/; evaluate the trained "
                 f"models first with: python -m benchmarks.reference evaluate"
@@ -528,11 +581,8 @@ def main(argv: list[str] | None = None) -> int:
                 file=sys.stderr,
             )
             return 1
-        OUT.mkdir(parents=True, exist_ok=True)
-        (OUT / "reference.md").write_text(text)
-        if args.update_results:
-            TRACKED.write_text(text)
-        print(text)
+        print(render(data))
+        _results.write("reference", data, args.out, args.update_results)
     return 0
 
 

@@ -10,20 +10,21 @@ repetitions, each on a freshly loaded Scene so that no per-scene cache is reused
 prints a markdown table with the growth exponent (least-squares slope of
 log(time) against log(edges)), and compares with what a user would otherwise do:
 classify a 100 x 100 grid of placements with pyvispoly (CGAL) visibility polygons
-for the stationary complete query.  The table is also written to
-``benchmarks/results/regions.md``.  pyvispoly is optional (GPL, dev extra); without
-it the comparison is skipped.
+for the stationary complete query.  The data (``regions.json``) and the page fragment
+(``regions.md``) go to ``--out`` (default ``runs/benchmarks/regions/``), or with
+``--update-results`` to the tracked ``benchmarks/results/regions.json`` and
+``docs/results/regions.md`` (the swept queries likewise, as ``swept``).  pyvispoly is optional
+(GPL, dev extra); without it the comparison is skipped.
 """
 
 from __future__ import annotations
 
 import argparse
 import math
-import platform
 import statistics
 import time
 from collections.abc import Callable
-from pathlib import Path
+from typing import Any
 
 import numpy as np
 import shapely
@@ -31,9 +32,10 @@ import shapely
 from geometry import Scene, complete_region, partial_region, recognizable_region
 from geometry.generate import scene_with_edges
 
+from . import _results
+
 EDGES = (25, 50, 100, 160, 200)
 SEED = 1
-RESULTS = Path(__file__).resolve().parent / "results" / "regions.md"
 
 
 def _point_variant(d: dict) -> dict:
@@ -169,6 +171,7 @@ def main(argv: list[str] | None = None) -> str:
     ap.add_argument(
         "--no-swept", action="store_true", help="skip the swept partial queries (benchmarks.swept)"
     )
+    _results.add_output_args(ap, "regions")
     args = ap.parse_args(argv)
     reps = args.reps or (5 if args.quick else 15)
 
@@ -179,40 +182,30 @@ def main(argv: list[str] | None = None) -> str:
         for _, var, fn in _queries():
             fn(Scene.from_dict(variants[n][var]))
 
-    lines = []
-    head = "| query | " + " | ".join(f"{actual[n]} edges" for n in EDGES) + " | growth exponent |"
+    data: dict[str, Any] = {
+        "command": _results.command("benchmarks.regions", argv),
+        "machine": _results.machine(),
+        "reps": reps,
+        "seed": SEED,
+        "edges": [actual[n] for n in EDGES],
+        "rows": [],
+        "grid": None,
+    }
     medians: dict[tuple[str, bool], list[float]] = {}
     for warm in (True, False):
-        lines.append("")
-        lines.append(
-            "**Warm** (repeated queries on one loaded Scene):"
-            if warm
-            else "**Cold** (first query on a freshly loaded Scene, building its visibility domain):"
-        )
-        lines.append("")
-        lines.append(head)
-        lines.append("|" + "---|" * (len(EDGES) + 2))
         for name, var, fn in _queries():
-            cells = []
-            meds = []
+            meds, iqrs = [], []
             for n in EDGES:
                 med, iqr = _time(fn, variants[n][var], reps, warm)
                 meds.append(med)
-                cells.append(f"{med * 1e3:.2f} ms (IQR {iqr * 1e3:.2f})")
+                iqrs.append(iqr)
             medians[(name, warm)] = meds
-            slope = _slope([actual[n] for n in EDGES], meds)
-            lines.append(f"| {name} | " + " | ".join(cells) + f" | {slope:.2f} |")
-
-    notes = [
-        "",
-        f"Median wall time (IQR) over {reps} repetitions; "
-        f"scenes `scene_with_edges(n, seed={SEED})` (6-vertex target, polygonal G/H; the point "
-        "variant shrinks G and H to a point inside each). Growth exponent: slope of "
-        "log(time) vs log(edges).",
-        f"Machine: {platform.processor() or platform.machine()}, "
-        f"Python {platform.python_version()}, "
-        f"shapely {shapely.__version__}, numpy {np.__version__}.",
-    ]
+            data["rows"].append({"query": name, "warm": warm, "median_s": meds, "iqr_s": iqrs})
+            print(
+                f"{'warm' if warm else 'cold'} {name}: "
+                + ", ".join(f"{m * 1e3:.2f} ms" for m in meds),
+                flush=True,
+            )
     try:
         import pyvispoly  # noqa: F401
 
@@ -223,35 +216,75 @@ def main(argv: list[str] | None = None) -> str:
     if have_pv:
         grid = 20 if args.quick else 100
         secs, _ = _grid_oracle(scenes[n_bench], grid)
-        scale = (100 * 100) / (grid * grid)
-        est = secs * scale
-        exact = medians[("complete, stationary", True)][EDGES.index(n_bench)]
-        cold = medians[("complete, stationary", False)][EDGES.index(n_bench)]
-        how = (
-            "measured"
-            if grid == 100
-            else f"measured on a {grid}x{grid} subgrid and scaled x{scale:g}"
-        )
-        notes += [
-            "",
-            "Alternative without this package: classify a 100x100 grid of placements with "
-            "pyvispoly (CGAL) visibility polygons for the stationary complete query on the "
-            f"{actual[n_bench]}-edge "
-            f"scene: {est:.3f} s ({how}); exact complete_region: {exact * 1e3:.2f} ms warm, "
-            f"{cold * 1e3:.2f} ms cold; speed-up x{est / exact:,.0f} warm, x{est / cold:,.0f} cold "
-            "(and the grid answer is only a raster).",
-        ]
-    else:
-        notes += ["", "pyvispoly not installed: grid comparison skipped."]
-    text = "\n".join(lines + notes).strip() + "\n"
+        data["grid"] = {"edges": actual[n_bench], "grid": grid, "seconds": secs}
+    text = render(data)
     print(text)
-    RESULTS.parent.mkdir(parents=True, exist_ok=True)
-    RESULTS.write_text("# Region query benchmark (`python -m benchmarks.regions`)\n\n" + text)
+    _results.write("regions", data, args.out, args.update_results)
     if not args.no_swept:  # the swept partial queries (paper 3.2.2-3.2.3, 5.2): seconds each
         from . import swept
 
-        swept.main(["--quick"] if args.quick else [])
+        out = ["--out", str(args.out.parent / "swept")]
+        swept.main(
+            (["--quick"] if args.quick else [])
+            + (["--update-results"] if args.update_results else out)
+        )
     return text
+
+
+def render(data: dict[str, Any]) -> str:
+    """The page fragment: warm and cold medians (ms) per query and scene size, the log-log
+    growth slope, and the grid of pyvispoly visibility polygons for comparison."""
+    edges = data["edges"]
+    lines: list[str] = []
+    for warm in (True, False):
+        lines += [
+            "",
+            "**Warm** (repeated queries on one loaded Scene):"
+            if warm
+            else "**Cold** (first query on a freshly loaded Scene, building its visibility "
+            "domain):",
+            "",
+            "| query | " + " | ".join(f"{n} edges" for n in edges) + " | growth (log-log slope) |",
+            "| --- |" + " ---: |" * (len(edges) + 1),
+        ]
+        for r in data["rows"]:
+            if r["warm"] != warm:
+                continue
+            cells = [f"{m * 1e3:.1f} ms" for m in r["median_s"]]
+            slope = _slope(edges, r["median_s"])
+            lines.append(f"| {r['query']} | " + " | ".join(cells) + f" | {slope:.2f} |")
+    m = data["machine"]
+    lines += [
+        "",
+        f"`{data['command']}`: median wall time over {data['reps']} repetitions; scenes "
+        f"`scene_with_edges(n, seed={data['seed']})` (6-vertex target, polygonal G/H; the point "
+        f"variant shrinks G and H to a point inside each); {m['cpus']} CPUs, Python "
+        f"{m['python']}, shapely {m['shapely']}, numpy {m['numpy']}, load average "
+        f"{m['load_average']}.",
+    ]
+    g = data.get("grid")
+    if g:
+        i = edges.index(g["edges"])
+        warm = next(r for r in data["rows"] if r["warm"] and r["query"] == "complete, stationary")
+        cold = next(
+            r for r in data["rows"] if not r["warm"] and r["query"] == "complete, stationary"
+        )
+        scale = (100 * 100) / (g["grid"] ** 2)
+        est = g["seconds"] * scale
+        how = (
+            "measured"
+            if g["grid"] == 100
+            else f"measured on a {g['grid']}x{g['grid']} grid, scaled"
+        )
+        lines += [
+            "",
+            "Without this package: classifying a 100 x 100 grid of placements with pyvispoly "
+            "(CGAL) visibility polygons for the stationary complete query on the "
+            f"{g['edges']}-edge "
+            f"scene takes {est:.2f} s ({how}), {est / warm['median_s'][i]:,.0f} x the warm exact "
+            f"query and {est / cold['median_s'][i]:,.0f} x the cold one, and gives only a raster.",
+        ]
+    return "\n".join(lines).strip() + "\n"
 
 
 if __name__ == "__main__":

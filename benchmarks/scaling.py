@@ -21,19 +21,21 @@ the log-log growth slope (least squares over 100 .. 1,600 edges).  It also times
 swept partial queries at 100 edges with and without the index (same run).  Up to ``--brute-max``
 edges (default 1,600) the complete and partial queries are also timed with the grid index
 switched off (the numpy brute-force ray casts, the code path without numba), so the
-speed-up is read off one run.  Written to
-``benchmarks/results/scaling.md``.  pyvispoly is optional (dev extra); without it the
+speed-up is read off one run.  The data (``scaling.json``) and the page fragment
+(``scaling.md``) go to ``--out`` (default ``runs/benchmarks/scaling/``), or with
+``--update-results`` to the tracked ``benchmarks/results/scaling.json`` and
+``docs/results/scaling.md``.  pyvispoly is optional (dev extra); without it the
 anchor columns are empty.  The machine is shared: quote ratios and medians.
 """
 
 from __future__ import annotations
 
 import argparse
-import platform
 import statistics
 import time
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import shapely
@@ -41,9 +43,10 @@ import shapely
 from geometry import Scene, complete_region, partial_region, recognizable_region
 from geometry.generate import scene_with_edges
 
+from . import _results
+
 EDGES = (100, 200, 400, 800, 1600, 3200, 8000)
 SEED = 1
-RESULTS = Path(__file__).resolve().parent / "results" / "scaling.md"
 OFFICE = (
     Path(__file__).resolve().parent.parent
     / "sensorplan_gym"
@@ -151,7 +154,9 @@ def _brute(fn: Callable[[], object], reps: int, budget: float) -> float:
 
 def run(
     edges: tuple[int, ...], reps: int, budget: float, office: bool = True, brute_max: int = 1600
-) -> str:
+) -> dict[str, Any]:
+    """Time every case; returns the rows (seconds; ``None`` where not measured) and, with the
+    office floor, the env timings."""
     rows = []
     cases: list[tuple[str, int, Scene]] = []
     for n in edges:
@@ -160,61 +165,97 @@ def run(
     if office and OFFICE.exists():
         s = Scene.load(OFFICE)
         cases.append(("office floor", len(s.bounds) + sum(len(o) for o in s.obstacles), s))
-    times: dict[str, dict[int, float]] = {q: {} for q, _ in QUERIES}
     for label, n, s in cases:
         anchor = _anchor(s)
-        row = [label, str(n), _fmt_ms(anchor)]
+        row: dict[str, Any] = {"scene": label, "edges": n, "anchor_s": anchor, "query_s": {}}
         for qname, fn in QUERIES:
             t = _median_time(lambda fn=fn, s=s: fn(s), reps, budget)
-            if label.isdigit():
-                times[qname][n] = t
-            ratio = f"{t / anchor:,.0f}x" if anchor else "-"
-            row.append(f"{_fmt_ms(t)} ({ratio})")
+            row["query_s"][qname] = t
             print(f"  {label:>12} edges={n:5d} {qname:24s} {_fmt_ms(t):>8} ms", flush=True)
+        row["brute_s"] = {}
         for qname, fn in QUERIES[:2]:
             if n <= brute_max:
                 tb = _brute(lambda fn=fn, s=s: fn(s), reps, budget)
                 print(f"  {label:>12} edges={n:5d} {qname:24s} {_fmt_ms(tb):>8} ms (brute)")
-                row.append(_fmt_ms(tb))
+                row["brute_s"][qname] = tb
             else:
-                row.append("-")
+                row["brute_s"][qname] = None
         rows.append(row)
-    slopes = []
-    for qname, _ in QUERIES:
-        pts = sorted((n, t) for n, t in times[qname].items() if 100 <= n <= 1600)
-        slopes.append(f"{_slope(*zip(*pts, strict=True)):.2f}" if len(pts) >= 2 else "-")
-    head = (
-        "| scene | edges | pyvispoly point query, ms | "
-        + " | ".join(f"{q}, ms (x anchor)" for q, _ in QUERIES)
-        + " | "
-        + " | ".join(f"{q} without the index, ms" for q, _ in QUERIES[:2])
-        + " |"
-    )
-    lines = [
-        f"Machine: {platform.processor() or platform.machine()}, Python "
-        f"{platform.python_version()}; median of up to {reps} warm calls; anchor = median "
-        "CGAL visibility polygon (pyvispoly) at 20 free points of the same scene, same run.",
-        "",
-        head,
-        "|" + " --- |" * (5 + len(QUERIES)),
-        *("| " + " | ".join(r) + " |" for r in rows),
-        "| growth slope 100 -> 1,600 | | | " + " | ".join(slopes) + " | | |",
-    ]
+    data: dict[str, Any] = {"reps": reps, "rows": rows, "office_env": None, "swept": None}
     if office and OFFICE.exists():
         t_make, t_reset = _env_times()
+        data["office_env"] = {"make_s": t_make, "reset_s": t_reset}
+    return data
+
+
+def render(data: dict[str, Any]) -> str:
+    """The page fragment: medians (ms) with their ratio to the anchor, the growth slopes over
+    100 .. 1,600 edges, the office floor's env timings and the swept queries."""
+    qnames = [q for q, _ in QUERIES]
+    head = (
+        "| scene | edges | pyvispoly point query (anchor) | "
+        + " | ".join(f"{q} (x anchor)" for q in qnames)
+        + " | "
+        + " | ".join(f"{q}, no index" for q in qnames[:2])
+        + " |"
+    )
+    lines = [head, "| --- |" + " ---: |" * (4 + len(qnames))]
+    for r in data["rows"]:
+        a = r["anchor_s"]
+        cells = [r["scene"] if not r["scene"].isdigit() else "generated", f"{r['edges']:,}"]
+        cells.append(f"{_fmt_ms(a)} ms" if a else "-")
+        for q in qnames:
+            t = r["query_s"][q]
+            cells.append(f"{_fmt_ms(t)} ms" + (f" ({t / a:,.0f}x)" if a else ""))
+        for q in qnames[:2]:
+            t = r["brute_s"].get(q)
+            cells.append(f"{_fmt_ms(t)} ms" if t is not None else "")
+        lines.append("| " + " | ".join(cells) + " |")
+    slopes = []
+    for q in qnames:
+        pts = sorted(
+            (r["edges"], r["query_s"][q])
+            for r in data["rows"]
+            if r["scene"].isdigit() and 100 <= r["edges"] <= 1600
+        )
+        slopes.append(f"{_slope(*zip(*pts, strict=True)):.2f}" if len(pts) >= 2 else "-")
+    lines.append("| growth slope 100 -> 1,600 | | | " + " | ".join(slopes) + " | | |")
+    m = data["machine"]
+    lines += [
+        "",
+        f"`{data['command']}`: median of up to {data['reps']} warm calls; anchor = median CGAL "
+        "visibility polygon (pyvispoly) at 20 free points of the same scene, same run; "
+        f"{m['cpus']} CPUs, Python {m['python']}, load average {m['load_average']}.",
+    ]
+    if data.get("office_env"):
+        e = data["office_env"]
         lines += [
             "",
-            f"Navigate-v0 on the office floor (complete model): gym.make {1e3 * t_make:,.0f} ms "
-            f"(the world is computed once), reset median {1e3 * t_reset:.2f} ms over 20 seeds.",
+            f"Navigate-v0 on the office floor (complete model): `gym.make` "
+            f"{1e3 * e['make_s']:,.0f} ms (the world is computed once), `reset` "
+            f"{1e3 * e['reset_s']:.2f} ms (median of 20 seeds).",
         ]
+    if data.get("swept"):
+        sw = data["swept"]
+        lines += [
+            "",
+            f"Swept queries, {sw['edges']} edges, G and H regular {sw['k']}-gons, fresh scene "
+            f"per call, median of {sw['reps']} (seconds):",
+            "",
+            "| query | with the index | without | ratio |",
+            "| --- | ---: | ---: | ---: |",
+        ]
+        for r in sw["rows"]:
+            a, b = r["with_s"], r["without_s"]
+            lines.append(f"| `{r['query']}` | {a:.2f} | {b:.2f} | {b / a:.1f}x |")
     return "\n".join(lines) + "\n"
 
 
-def swept_ab(n_edges: int = 100, k: int = 5, reps: int = 3) -> str:
+def swept_ab(n_edges: int = 100, k: int = 5, reps: int = 3) -> dict[str, Any]:
     """The swept partial queries (``partial_region(target_in="goal")`` and 5.2's
     ``recognizable_region(model="partial")``, theta 0.3, G and H regular k-gons as in
     :mod:`benchmarks.swept`) with and without the index, alternating, each call on a freshly
-    loaded scene; medians and their ratio."""
+    loaded scene; returns the medians (seconds)."""
     from benchmarks.swept import _kgon
     from geometry import visindex
 
@@ -228,14 +269,7 @@ def swept_ab(n_edges: int = 100, k: int = 5, reps: int = 3) -> str:
             s, model="partial", theta=0.3
         ),
     }
-    lines = [
-        "",
-        f"Swept queries, {n_edges} edges, G and H regular {k}-gons, fresh scene per call, "
-        f"median of {reps} (seconds):",
-        "",
-        "| query | with the index | without | ratio |",
-        "| --- | ---: | ---: | ---: |",
-    ]
+    out: dict[str, Any] = {"edges": n_edges, "k": k, "reps": reps, "rows": []}
     saved = visindex._HAVE_NUMBA
     try:
         for name, fn in calls.items():
@@ -249,11 +283,11 @@ def swept_ab(n_edges: int = 100, k: int = 5, reps: int = 3) -> str:
                     fn(s)
                     res[on].append(time.perf_counter() - t0)
             a, b = statistics.median(res[True]), statistics.median(res[False])
-            lines.append(f"| `{name}` | {a:.2f} | {b:.2f} | {b / a:.1f}x |")
-            print(lines[-1], flush=True)
+            out["rows"].append({"query": name, "with_s": a, "without_s": b})
+            print(f"| `{name}` | {a:.2f} | {b:.2f} | {b / a:.1f}x |", flush=True)
     finally:
         visindex._HAVE_NUMBA = saved
-    return "\n".join(lines) + "\n"
+    return out
 
 
 def _env_times() -> tuple[float, float]:
@@ -294,23 +328,18 @@ def main(argv: list[str] | None = None) -> None:
         action="store_true",
         help="also the swept partial queries at 100 edges with and without the index",
     )
-    ap.add_argument("--out", type=Path, default=RESULTS)
+    _results.add_output_args(ap, "scaling")
     args = ap.parse_args(argv)
     edges = tuple(n for n in (args.edges or EDGES) if n <= args.max_edges)
-    table = run(edges, args.reps, args.budget, office=not args.no_office, brute_max=args.brute_max)
+    data = {
+        "command": _results.command("benchmarks.scaling", argv),
+        "machine": _results.machine(),
+        **run(edges, args.reps, args.budget, office=not args.no_office, brute_max=args.brute_max),
+    }
     if args.swept:
-        table += swept_ab()
-    print(table)
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    cmd = "python -m benchmarks.scaling" + (
-        f" --max-edges {args.max_edges}" if args.max_edges != max(EDGES) else ""
-    )
-    if args.edges:
-        cmd += " --edges " + " ".join(map(str, args.edges))
-    if args.no_office:
-        cmd += " --no-office"
-    cmd += f" --reps {args.reps}" + (" --swept" if args.swept else "")
-    args.out.write_text(f"# Scaling of the region queries\n\n`{cmd}`\n\n{table}", encoding="utf-8")
+        data["swept"] = swept_ab()
+    print(render(data))
+    _results.write("scaling", data, args.out, args.update_results)
 
 
 if __name__ == "__main__":

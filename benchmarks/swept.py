@@ -9,17 +9,18 @@ growth with the edges of G can be read off.  Times
 ``partial_region(target_in="goal", theta=0.3)`` and
 ``recognizable_region(model="partial", theta=0.3)`` (both sweeps, G and H, with
 the overlap strips of 5.2); median and IQR over the repetitions, each on a
-freshly loaded Scene.  The table is written to ``benchmarks/results/swept.md``.
+freshly loaded Scene.  The data (``swept.json``) and the page fragment (``swept.md``) go to
+``--out`` (default ``runs/benchmarks/swept/``), or with ``--update-results`` to the tracked
+``benchmarks/results/swept.json`` and ``docs/results/swept.md``.
 """
 
 from __future__ import annotations
 
 import argparse
 import math
-import platform
 import statistics
 import time
-from pathlib import Path
+from typing import Any
 
 import numpy as np
 import shapely
@@ -27,7 +28,7 @@ import shapely
 from geometry import Scene, partial_region, recognizable_region
 from geometry.generate import scene_with_edges
 
-RESULTS = Path(__file__).resolve().parent / "results" / "swept.md"
+from . import _results
 
 
 def _kgon(poly: list, k: int) -> list[list[float]]:
@@ -62,6 +63,7 @@ def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(prog="python -m benchmarks.swept", description=__doc__)
     ap.add_argument("--quick", action="store_true", help="one repetition, 25 and 100 edges")
     ap.add_argument("--reps", type=int, default=3)
+    _results.add_output_args(ap, "swept")
     args = ap.parse_args(argv)
     reps = 1 if args.quick else args.reps
     sizes = (25, 100) if args.quick else (25, 50, 100)
@@ -73,24 +75,51 @@ def main(argv: list[str] | None = None) -> None:
             lambda s: recognizable_region(s, model="partial", theta=0.3),
         ),
     ]
-    lines = [
-        f"Swept partial queries, median of {reps} (IQR), seconds; "
-        f"{platform.processor() or platform.machine()}, python {platform.python_version()}",
-        "",
-        "| query | env edges | k = edges of G | median s | IQR s |",
-        "|---|---|---|---|---|",
-    ]
+    data: dict[str, Any] = {
+        "command": _results.command("benchmarks.swept", argv),
+        "machine": _results.machine(),
+        "reps": reps,
+        "rows": [],
+    }
     for name, fn in queries:
         for n in sizes:
             for k in ks:
                 d = _scene(n, k)
                 med, iqr = _time(fn, d, reps)
-                line = f"| {name} | {n} | {k} | {med:.2f} | {iqr:.2f} |"
-                print(line, flush=True)
-                lines.append(line)
-    RESULTS.parent.mkdir(exist_ok=True)
-    RESULTS.write_text("\n".join(lines) + "\n")
-    print(f"written to {RESULTS}")
+                data["rows"].append(
+                    {"query": name, "edges": n, "k": k, "median_s": med, "iqr_s": iqr}
+                )
+                print(f"| {name} | {n} | {k} | {med:.2f} | {iqr:.2f} |", flush=True)
+    _results.write("swept", data, args.out, args.update_results)
+
+
+def render(data: dict[str, Any]) -> str:
+    """The page fragment: one row per query and k, one column per scene size (median s)."""
+    sizes = sorted({r["edges"] for r in data["rows"]})
+    lines = [
+        "| query | k = edges of G | " + " | ".join(f"{n} env edges" for n in sizes) + " |",
+        "| --- | ---: |" + " ---: |" * len(sizes),
+    ]
+    seen: list[tuple[str, int]] = []
+    for r in data["rows"]:
+        if (r["query"], r["k"]) not in seen:
+            seen.append((r["query"], r["k"]))
+    last = None
+    for q, k in seen:
+        cells = []
+        for n in sizes:
+            m = [r for r in data["rows"] if (r["query"], r["k"], r["edges"]) == (q, k, n)]
+            cells.append(f"{m[0]['median_s']:.2f} s" if m else "")
+        label = f"`{q}`" if q != last else ""
+        last = q
+        lines.append(f"| {label} | {k} | " + " | ".join(cells) + " |")
+    m = data["machine"]
+    lines += [
+        "",
+        f"`{data['command']}`: median of {data['reps']} calls, each on a freshly loaded scene; "
+        f"{m['cpus']} CPUs, Python {m['python']}, load average {m['load_average']}.",
+    ]
+    return "\n".join(lines) + "\n"
 
 
 if __name__ == "__main__":

@@ -1,9 +1,13 @@
 """How close the swept partial region comes to a dense reference (paper 3.2.2-3.2.3).
 
 Run ``python -m benchmarks.swept_accuracy [first_seed] [last_seed]`` (default 0 10; about
-30 s a scene).  For random scenes with a polygonal G it compares the union of the swept
-shadows (:func:`geometry.sweep.swept_shadows`) with the union of 201 exact stationary shadows
-per edge of G (a subset of the true union):
+30 s a scene).  The data (``swept_accuracy.json``) and the page fragment go to ``--out``
+(default ``runs/benchmarks/swept_accuracy/``), or with ``--update-results`` to the tracked
+``benchmarks/results/swept_accuracy.json`` and ``docs/results/swept_accuracy.md``.
+
+For random scenes with a polygonal G it compares the union of the swept shadows
+(:func:`geometry.sweep.swept_shadows`) with the union of 201 exact stationary shadows per edge
+of G (a subset of the true union):
 
 * *missed*: area of the reference not in the sweep (the region would be too large), and the
   depth of the deepest missed sliver (``shapely.minimum_clearance``);
@@ -15,6 +19,7 @@ per edge of G (a subset of the true union):
 from __future__ import annotations
 
 import argparse
+from typing import Any
 
 import numpy as np
 import shapely
@@ -24,6 +29,8 @@ from geometry._common import scene_domain, target_spec
 from geometry.generate import random_scene
 from geometry.sweep import Sweeper, swept_shadows
 
+from . import _results
+
 
 def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(
@@ -31,8 +38,14 @@ def main(argv: list[str] | None = None) -> None:
     )
     ap.add_argument("first_seed", nargs="?", type=int, default=0, help="default 0")
     ap.add_argument("last_seed", nargs="?", type=int, default=10, help="default 10")
+    _results.add_output_args(ap, "swept_accuracy")
     args = ap.parse_args(argv)
     first, last = args.first_seed, args.last_seed
+    data: dict[str, Any] = {
+        "command": _results.command("benchmarks.swept_accuracy", argv),
+        "machine": _results.machine(),
+        "rows": [],
+    }
     for seed in range(first, last):
         rng = np.random.default_rng(seed)
         sc = Scene.from_dict(random_scene(rng, goal="polygon", n_obstacles=8))
@@ -69,6 +82,43 @@ def main(argv: list[str] | None = None) -> None:
             f"overshoot: {n_over}/{n_probe} probes unblinded, farthest {worst / tol:.2f} tol",
             flush=True,
         )
+        data["rows"].append(
+            {
+                "seed": seed,
+                "goal_edges": len(edges),
+                "missed_area": float(miss.area),
+                "missed_depth_tol": float(depth / tol),
+                "probes": n_probe,
+                "unblinded": n_over,
+                "overshoot_tol": float(worst / tol),
+            }
+        )
+    _results.write("swept_accuracy", data, args.out, args.update_results)
+
+
+def render(data: dict[str, Any]) -> str:
+    """The page fragment: per scene, the missed area and depth and the overshoot."""
+    lines = [
+        "| scene seed | edges of G | missed area | deepest missed sliver (tol) | overshoot probes "
+        "not blinded | farthest overshoot (tol) |",
+        "| ---: | ---: | ---: | ---: | ---: | ---: |",
+    ]
+    for r in data["rows"]:
+        lines.append(
+            f"| {r['seed']} | {r['goal_edges']} | {r['missed_area']:.1e} | "
+            f"{r['missed_depth_tol']:.3f} | {r['unblinded']}/{r['probes']} | "
+            f"{r['overshoot_tol']:.2f} |"
+        )
+    rows = data["rows"]
+    if rows:
+        lines += [
+            "",
+            f"`{data['command']}`, {len(rows)} scenes: deepest missed sliver "
+            f"{max(r['missed_depth_tol'] for r in rows):.3f} tol, farthest overshoot "
+            f"{max(r['overshoot_tol'] for r in rows):.2f} tol (`tol` = 1e-4 x the scene "
+            "diameter).",
+        ]
+    return "\n".join(lines) + "\n"
 
 
 if __name__ == "__main__":

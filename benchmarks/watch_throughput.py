@@ -6,7 +6,9 @@ Every env is stepped with uniform random actions (drawn before timing) for ``--s
 (episodes restart on their own as they end), ``--repeats`` times, interleaved, and the median
 wall time is kept.  Reported: env steps/s, agent steps/s (env steps x watchers) and the ratio
 of agent steps/s to Navigate-v0's env steps/s (the anchor, measured in the same run).  Writes
-``benchmarks/results/watch_throughput.md``.
+the data and the page fragment to ``--out`` (default ``runs/benchmarks/watch_throughput/``), or
+with ``--update-results`` to ``benchmarks/results/watch_throughput.json`` and
+``docs/results/watch_throughput.md``.
 """
 
 from __future__ import annotations
@@ -14,9 +16,11 @@ from __future__ import annotations
 import argparse
 import statistics
 import time
-from pathlib import Path
+from typing import Any
 
 import numpy as np
+
+from . import _results
 
 
 def _gym_runner(env_id: str, scene: str, steps: int):
@@ -70,7 +74,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--scene", default="lab")
     ap.add_argument("--steps", type=int, default=2000)
     ap.add_argument("--repeats", type=int, default=5)
-    ap.add_argument("--out", default=str(Path(__file__).parent / "results" / "watch_throughput.md"))
+    _results.add_output_args(ap, "watch_throughput")
     a = ap.parse_args(argv)
     runners = {
         "Navigate-v0 (anchor)": _gym_runner("sensorplan/Navigate-v0", a.scene, a.steps),
@@ -84,24 +88,42 @@ def main(argv: list[str] | None = None) -> int:
     for _ in range(a.repeats):  # interleaved, so that load changes hit every env alike
         for k, (run, _n) in runners.items():
             times[k].append(run())
-    anchor = a.steps / statistics.median(times["Navigate-v0 (anchor)"])
+    data: dict[str, Any] = {
+        "command": _results.command("benchmarks.watch_throughput", argv),
+        "machine": _results.machine(),
+        "scene": a.scene,
+        "steps": a.steps,
+        "repeats": a.repeats,
+        "rows": [
+            {"env": k, "agents": n, "median_s": statistics.median(times[k])}
+            for k, (_run, n) in runners.items()
+        ],
+    }
+    print(render(data))
+    _results.write("watch_throughput", data, a.out, a.update_results)
+    return 0
+
+
+def render(data: dict[str, Any]) -> str:
+    """The page fragment: env and agent steps/s, and agent steps/s over Navigate-v0's."""
+    steps = data["steps"]
+    anchor = steps / data["rows"][0]["median_s"]
     lines = [
-        f"Random actions, scene `{a.scene}`, {a.steps} steps x {a.repeats} repeats (median), "
-        "complete model, 16 beams.",
-        "",
-        "| env | env steps/s | agents | agent steps/s | agent steps/s vs Navigate-v0 |",
+        "| env | env steps/s | agents | agent steps/s | agent steps/s vs Navigate-v0 (same run) |",
         "| --- | ---: | ---: | ---: | ---: |",
     ]
-    for k, (_run, n) in runners.items():
-        sps = a.steps / statistics.median(times[k])
-        lines.append(f"| {k} | {sps:,.0f} | {n} | {sps * n:,.0f} | {sps * n / anchor:.2f} |")
-    text = "\n".join(lines)
-    print(text)
-    Path(a.out).parent.mkdir(parents=True, exist_ok=True)
-    Path(a.out).write_text(
-        "# watch_v0 throughput\n\n`python -m benchmarks.watch_throughput`\n\n" + text + "\n"
-    )
-    return 0
+    for r in data["rows"]:
+        sps = steps / r["median_s"]
+        n = r["agents"]
+        lines.append(f"| {r['env']} | {sps:,.0f} | {n} | {sps * n:,.0f} | {sps * n / anchor:.2f} |")
+    m = data["machine"]
+    lines += [
+        "",
+        f"`{data['command']}`: random actions on `{data['scene']}`, {steps} steps, median of "
+        f"{data['repeats']} interleaved repeats; {m['cpus']} CPUs, load average "
+        f"{m['load_average']} (compare the ratios).",
+    ]
+    return "\n".join(lines) + "\n"
 
 
 if __name__ == "__main__":  # pragma: no cover

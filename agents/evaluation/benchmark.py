@@ -35,7 +35,7 @@ from typing import Any
 from ..checks import check_writable_dir
 from ..learning.policies import check_policies, make_env
 from .episodes import EVAL_SEED_BASE
-from .evaluate import evaluate
+from .evaluate import evaluate, fresh_dir
 
 __all__ = ["DEFAULT_DIFFICULTY", "TEST_POOL_SEED", "TRAIN_POOL_SEED", "benchmark", "splits"]
 
@@ -106,7 +106,7 @@ def benchmark(
 
     check_policies(policies)  # every path, before any episode is played
     out = check_writable_dir(
-        out if out is not None else Path("runs") / f"benchmark_{env_id.split('/')[-1]}"
+        out if out is not None else fresh_dir(Path("runs") / f"benchmark_{env_id.split('/')[-1]}")
     )
     base = dict(env_kwargs or {})
     probe = make_env(env_id, {k: v for k, v in base.items() if k != "scene"})

@@ -179,6 +179,18 @@ def _unique(names: list[str]) -> list[str]:
     return out
 
 
+def fresh_dir(base: Path) -> Path:
+    """``base`` if it does not exist yet, else the first of ``base.2``, ``base.3``, ... that
+    does not: the default output folder of a run, so that consecutive runs never overwrite
+    each other's results."""
+    base = Path(base)
+    d, k = base, 1
+    while d.exists():
+        k += 1
+        d = base.with_name(f"{base.name}.{k}")
+    return d
+
+
 def evaluate(
     env_id: str,
     policies: list[str],
@@ -216,7 +228,9 @@ def evaluate(
         outdir = check_writable_dir(
             out
             if out is not None
-            else Path("runs") / f"eval_{env_id.split('/')[-1].split('-v')[0].lower()}_s{seed}"
+            else fresh_dir(
+                Path("runs") / f"eval_{env_id.split('/')[-1].split('-v')[0].lower()}_s{seed}"
+            )
         )
     if env_id not in gym.registry:
         raise ValueError(

@@ -81,20 +81,22 @@ def test_fine_scene_start_is_kept():
 
 
 def test_oracle_benchmark_leaves_the_tracked_results_alone(tmp_path, monkeypatch):
+    import benchmarks._results as br
     import benchmarks.oracle as bo
 
-    tracked = tmp_path / "tracked" / "oracle.md"
-    monkeypatch.setattr(bo, "TRACKED", tracked)
+    monkeypatch.setattr(br, "DATA_DIR", tmp_path / "data")
+    monkeypatch.setattr(br, "FRAGMENT_DIR", tmp_path / "docs")
     monkeypatch.setattr(bo, "ENVS", ["sensorplan/Placement-v0"])
     monkeypatch.setattr(bo, "SCENES", ["lab"])
-    out = tmp_path / "out" / "oracle.md"
+    out = tmp_path / "out"
     bo.main(["--episodes", "1", "--random-scenes", "0", "--out", str(out)])
-    assert out.is_file() and not tracked.exists()
-    assert "| sensorplan/Placement-v0 | lab | 1 |" in out.read_text()
-    out.unlink()
+    assert (out / "oracle.json").is_file() and not (tmp_path / "data").exists()
+    assert "| Placement-v0 | 1/1 |" in (out / "oracle.md").read_text()
+    (out / "oracle.json").unlink()
     bo.main(["--episodes", "1", "--random-scenes", "0", "--out", str(out), "--update-results"])
-    assert tracked.is_file() and not out.exists()
-    assert bo.DEFAULT_OUT.parts[0] == "runs"  # git-ignored
+    assert (tmp_path / "data" / "oracle.json").is_file()
+    assert (tmp_path / "docs" / "oracle.md").is_file() and not (out / "oracle.json").exists()
+    assert br.DEFAULT_OUT.parts[0] == "runs"  # git-ignored
 
 
 def test_scene_save_writes_one_vertex_per_line_and_round_trips_exactly(tmp_path):
