@@ -1,4 +1,5 @@
-"""``sensorplan`` command line: ``train``, ``evaluate`` and ``demo``.
+"""``sensorplan`` command line (also ``python -m agents``): ``train``, ``evaluate``,
+``benchmark``, ``demo``, ``convert``, ``view`` and ``record``.
 
     sensorplan train --env sensorplan/Navigate-v0 --algo ppo --timesteps 150000 --seed 0 --n-envs 2
     sensorplan evaluate --env sensorplan/Navigate-v0 --policies oracle random \\
@@ -12,6 +13,8 @@
                                                   lab.geojson; see geometry.formats)
     sensorplan view lab        (scenes and exact regions in the browser; --export view.html
                                 writes one self-contained file; see sensorplan_gym.viewer)
+    sensorplan record --policy oracle --out ep.json   (one episode for sensorplan view
+                                                        --rollout ep.json)
 """
 
 from __future__ import annotations
@@ -20,7 +23,9 @@ import argparse
 import json
 import sys
 
-__all__ = ["build_parser", "main"]
+from .checks import EXTRA_OF_MODULE, check_writable_file, missing_extra_message
+
+__all__ = ["EXTRA_OF_MODULE", "build_parser", "main"]
 
 ENV_CHOICES_HELP = "sensorplan/Placement-v0, sensorplan/Navigate-v0 or sensorplan/Recognize-v0"
 
@@ -43,7 +48,7 @@ def build_parser() -> argparse.ArgumentParser:
         description="Sensor planning (Briggs & Donald): train and evaluate agents, run the demo.",
     )
     sub = parser.add_subparsers(
-        dest="command", metavar="{train,evaluate,benchmark,demo,convert,view}"
+        dest="command", metavar="{train,evaluate,benchmark,demo,convert,view,record}"
     )
     sub.required = True
 
@@ -231,36 +236,34 @@ def build_parser() -> argparse.ArgumentParser:
     )
     c.add_argument("output", help="output file (.json, .geojson or .wkt)")
     c.add_argument("--name", default=None, help="scene name (default: from the input)")
+
+    r = sub.add_parser(
+        "record",
+        help="record one episode to a rollout file for `sensorplan view --rollout`",
+        description="Play one episode with a policy and save it (poses, beams, target, the "
+        "exact region) as rollout JSON; `sensorplan view SCENE --rollout FILE` replays it "
+        "(see sensorplan_gym.viewer.replay).",
+    )
+    r.add_argument("--env", default="sensorplan/Recognize-v0", help=ENV_CHOICES_HELP)
+    r.add_argument(
+        "--policy", default="oracle", help="'oracle' (default), 'random' or a model zip path"
+    )
+    r.add_argument(
+        "--scene",
+        default="lab",
+        help="bundled scene name or scene file: scene JSON, GeoJSON or WKT (default: lab)",
+    )
+    r.add_argument("--seed", type=int, default=0)
+    r.add_argument("--max-steps", type=int, default=None)
+    r.add_argument("--env-kwargs", type=_json_dict, default=None, help="JSON gym.make kwargs")
+    r.add_argument("--out", default="rollout.json", help="rollout file (default rollout.json)")
     return parser
 
 
-#: top-level modules of the optional extras -> the extra that installs them
-EXTRA_OF_MODULE = {
-    "yaml": "rl",
-    "stable_baselines3": "rl",
-    "sb3_contrib": "rl",
-    "torch": "rl",
-    "tqdm": "rl",
-    "rich": "rl",
-    "tensorboard": "rl",
-    "pettingzoo": "multi",
-    "ray": "multi",
-    "bokeh": "viewer",
-}
-
-
 def _missing_extra_message(command: str, err: ImportError) -> str | None:
-    """The 'install this extra' message for an ImportError of an optional dependency, or
-    ``None`` when the missing module belongs to no extra (a real bug: re-raise it)."""
-    name = (getattr(err, "name", None) or "").split(".")[0]
-    extra = EXTRA_OF_MODULE.get(name)
-    if extra is None:
-        return None
-    return (
-        f"sensorplan {command}: error: the Python module {name!r} is missing; it comes with "
-        f'the "{extra}" extra: pip install -e ".[{extra}]" in a checkout, '
-        f'pip install "sensorplan-gym[{extra}]" otherwise'
-    )
+    """The 'install this extra' message of ``sensorplan <command>`` for an ImportError of an
+    optional dependency, or ``None`` when the module belongs to no extra (re-raise it)."""
+    return missing_extra_message(f"sensorplan {command}", err)
 
 
 def _hp_overrides(items: list[str] | None) -> dict:
@@ -283,6 +286,33 @@ def _hp_overrides(items: list[str] | None) -> dict:
                 pass
         out[key] = v
     return out
+
+
+def _record(args: argparse.Namespace) -> int:
+    """``sensorplan record``: the viewer's recorder (below the agents) gets the policy from
+    here (:func:`agents.learning.policies.load_policy`)."""
+    from sensorplan_gym.viewer.replay import record_rollout, save_rollout
+
+    from .learning.policies import check_policies, load_policy
+
+    check_writable_file(args.out)
+    spec = args.policy
+    check_policies([spec])
+    if spec == "random":
+        policy: object = "random"
+    else:
+        policy = lambda env: load_policy(spec, env, seed=args.seed)  # noqa: E731
+    ro = record_rollout(
+        args.env,
+        policy=policy,
+        policy_name=spec,
+        seed=args.seed,
+        max_steps=args.max_steps,
+        **{**(args.env_kwargs or {}), "scene": args.scene},
+    )
+    p = save_rollout(ro, args.out)
+    print(f"wrote {p}: {len(ro['steps']) - 1} steps, return {ro['return']:.3f}")
+    return 0
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -320,6 +350,8 @@ def main(argv: list[str] | None = None) -> int:
                 f"{len(scene.obstacles)} obstacles, {n_edges} edges"
             )
             return 0
+        if args.command == "record":
+            return _record(args)
         if args.command == "train" and args.backend == "rllib":
             from .learning.rllib_train import train_rllib
 
@@ -404,6 +436,10 @@ def main(argv: list[str] | None = None) -> int:
     except (ValueError, KeyError, FileNotFoundError, NotImplementedError) as err:
         msg = err.args[0] if isinstance(err, KeyError) and err.args else err
         print(f"sensorplan {args.command}: error: {msg}", file=sys.stderr)
+        return 2
+    except OSError as err:  # e.g. a folder that became unwritable while running
+        where = f": {err.filename}" if err.filename else ""
+        print(f"sensorplan {args.command}: error: {err.strerror or err}{where}", file=sys.stderr)
         return 2
     return 1  # pragma: no cover - argparse rejects unknown commands
 

@@ -139,7 +139,9 @@ def train_sps(vec_env: str, timesteps: int, n_envs: int | None = None, n_steps=N
 
 
 def main(argv=None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(
+        prog="python -m benchmarks.envs", description=__doc__.splitlines()[0]
+    )
     ap.add_argument("--quick", action="store_true", help="fewer steps (smoke run)")
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--train", action="store_true", help="also time PPO training")

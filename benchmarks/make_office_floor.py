@@ -141,8 +141,16 @@ def n_edges(d: dict) -> int:
     return len(d["bounds"]) + sum(len(o) for o in d["obstacles"])
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
+    """(Re)write ``office_floor.json`` (no options; ``--help`` describes the scene)."""
+    import argparse
+
     from geometry import Scene
+
+    argparse.ArgumentParser(
+        prog="python -m benchmarks.make_office_floor",
+        description=__doc__.split("\n\n")[0] + f"  Writes {OUT / 'office_floor.json'}.",
+    ).parse_args(argv)
 
     d = office_floor()
     s = Scene.from_dict(d)

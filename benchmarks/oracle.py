@@ -41,7 +41,9 @@ def episode(env, policy, seed: int) -> bool:
 
 
 def main(argv: list[str] | None = None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap = argparse.ArgumentParser(
+        prog="python -m benchmarks.oracle", description=__doc__.split("\n\n")[0]
+    )
     ap.add_argument("--episodes", type=int, default=100)
     ap.add_argument("--random-scenes", type=int, default=200)
     _results.add_output_args(ap, "oracle")

@@ -323,15 +323,15 @@ def evaluate_grid(
     envs: list[str] | None = None,
     only: list[Entry] | None = None,
     new: bool = False,
-) -> int:
+) -> tuple[int, int]:
     """``sensorplan benchmark`` per env (and per action type) with every trained model;
     ``envs``: only these env ids.  ``only``: only these entries' models, without the
     baselines, into ``<group>/models-<entry>/`` (:func:`report` merges them; a model's
     episodes do not depend on which other policies are evaluated with it); ``new``: only
-    models not evaluated yet.  Returns the number of models evaluated."""
+    models not evaluated yet.  Returns ``(models found, models evaluated)``."""
     from agents.evaluation.benchmark import benchmark
 
-    n_models = 0
+    found = evaluated = 0
     for env_id in envs or (PLACE, REC, NAV):
         for discrete in (False, True):
             entries = [e for e in GRID if e.env_id == env_id and e.discrete == discrete]
@@ -339,8 +339,9 @@ def evaluate_grid(
             done = _evaluated(env_id, discrete) if new else set()
             if only is None and not new:
                 models = _models(entries)
+                found += len(models)
+                evaluated += len(models)
                 if models:
-                    n_models += len(models)
                     base = ["random"] if discrete else ["oracle", "random"]
                     benchmark(
                         env_id,
@@ -354,9 +355,11 @@ def evaluate_grid(
             for e in entries:
                 if only is not None and e not in only:
                     continue
-                models = [m for m in _models([e]) if m not in done]
+                every = _models([e])
+                models = [m for m in every if m not in done]
+                found += len(every)
+                evaluated += len(models)
                 if models:
-                    n_models += len(models)
                     benchmark(
                         env_id,
                         models,
@@ -365,7 +368,7 @@ def evaluate_grid(
                         env_kwargs=kw,
                         out=_models_dir(_group_dir(env_id, discrete), e.key, new),
                     )
-    return n_models
+    return found, evaluated
 
 
 def _models_dir(group: Path, key: str, new: bool) -> Path:
@@ -549,20 +552,33 @@ def main(argv: list[str] | None = None) -> int:
             return 0
         train_grid(entries, args.seeds)
     elif args.cmd == "evaluate":
-        n = evaluate_grid(
+        found, evaluated = evaluate_grid(
             args.episodes,
             envs=args.envs,
             only=_selected(args.only) if args.only else None,
             new=args.new,
         )
-        if n == 0:
-            what = "model not evaluated yet" if args.new else "trained model"
-            print(f"nothing to evaluate: no {what} under {RUNS}/ (run `train` first)")
+        if not found:
+            print(
+                f"nothing to evaluate: no finished run of the selected grid entries under "
+                f"{RUNS}/ (a run is finished when its final_model.zip exists); train them "
+                f"with: python -m benchmarks.reference train"
+            )
             return 1
+        if not evaluated:
+            print(
+                f"nothing new to evaluate: all {found} finished runs of the selected entries "
+                f"have results under {OUT}/ (without --new every model is evaluated again)"
+            )
     else:
         data = {"command": _results.command("benchmarks.reference", argv), **report_data()}
         if not data["envs"]:
-            print(f"nothing to report: no evaluated model under {OUT} (run `evaluate` first)")
+            print(
+                f"nothing to report: no benchmark results under {OUT}/; evaluate the trained "
+                f"models first with: python -m benchmarks.reference evaluate"
+                + (" (the tracked results left as they are)" if args.update_results else ""),
+                file=sys.stderr,
+            )
             return 1
         print(render(data))
         _results.write("reference", data, args.out, args.update_results)

@@ -163,7 +163,9 @@ def _grid_oracle(d: dict, n: int) -> tuple[float, int]:
 
 
 def main(argv: list[str] | None = None) -> str:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(
+        prog="python -m benchmarks.regions", description=__doc__.splitlines()[0]
+    )
     ap.add_argument("--quick", action="store_true", help="fewer repetitions, 20x20 grid")
     ap.add_argument("--reps", type=int, default=None, help="repetitions per measurement")
     ap.add_argument(

@@ -308,7 +308,9 @@ def _env_times() -> tuple[float, float]:
 
 
 def main(argv: list[str] | None = None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap = argparse.ArgumentParser(
+        prog="python -m benchmarks.scaling", description=__doc__.split("\n\n")[0]
+    )
     ap.add_argument("--max-edges", type=int, default=max(EDGES))
     ap.add_argument(
         "--edges", type=int, nargs="+", default=None, help="scene sizes (default: 100 .. 8000)"

@@ -60,7 +60,7 @@ def _time(fn, d: dict, reps: int) -> tuple[float, float]:
 
 
 def main(argv: list[str] | None = None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__)
+    ap = argparse.ArgumentParser(prog="python -m benchmarks.swept", description=__doc__)
     ap.add_argument("--quick", action="store_true", help="one repetition, 25 and 100 edges")
     ap.add_argument("--reps", type=int, default=3)
     _results.add_output_args(ap, "swept")

@@ -2,7 +2,7 @@
 
     python -m benchmarks.watch_oracle [--episodes 200] [--seed 0]
 
-:func:`agents.planning.watch_oracle.evaluate_watch` of the oracle and of uniform random actions
+:func:`agents.evaluation.watch.evaluate_watch` of the oracle and of uniform random actions
 on ``corridor``, ``edr``, ``lab`` and ``warehouse`` with 1 and 2 watchers, the same episode
 seeds (1,000,000 + seed onwards) for every row; complete model, 16 beams, watchers starting at
 seeded random free poses.  The data (``watch_oracle.json``, without the per-episode lists) and
@@ -18,7 +18,7 @@ import time
 from typing import Any
 
 from agents.evaluation.evaluate import EVAL_SEED_BASE
-from agents.planning.watch_oracle import evaluate_watch
+from agents.evaluation.watch import evaluate_watch
 from sensorplan_gym.core.world import BUNDLED_SCENES
 
 from . import _results

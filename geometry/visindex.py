@@ -17,7 +17,7 @@ local-obstruction test of viewpoints on the boundary, and lets the compiled angu
 of :func:`sorted_gaps` visit only the vertices in the cells a narrow sector meets.
 :func:`window_ranges` is the compiled twin of the window clipping of the swept point
 test (:meth:`geometry.sweep.Sweeper._windows`).  Every compiled step is tested against
-the numpy code bit for bit (``tests/test_large_oracle.py``).
+the numpy code bit for bit (``tests/geometry/test_large_oracle.py``).
 
 numba is an optional dependency (the ``fast`` extra).  Without it :func:`available`
 is False and :mod:`geometry._vis` keeps its vectorised brute-force code.
@@ -44,7 +44,7 @@ except ImportError:  # pragma: no cover
     _HAVE_NUMBA = False
 
 if TYPE_CHECKING:  # pragma: no cover
-    from ._vis import Domain
+    from ._domain import Domain
 
 __all__ = [
     "SegmentGrid",

@@ -10,9 +10,13 @@ without a prior import.  Rewards are exact: they come from
 >>> obs, info = env.reset(seed=0)
 """
 
-from .core.world import BUNDLED_SCENES
-from .registration import ENV_IDS, register_sensorplan_envs
+#: the version of the sensorplan-gym distribution (geometry, sensorplan_gym, agents): written
+#: here only; pyproject.toml reads it, CHANGELOG.md lists what each version changed
+__version__ = "0.1.0"
+
+from .core.world import BUNDLED_SCENES  # noqa: E402
+from .registration import ENV_IDS, register_sensorplan_envs  # noqa: E402
 
 register_sensorplan_envs()
 
-__all__ = ["BUNDLED_SCENES", "ENV_IDS", "register_sensorplan_envs"]
+__all__ = ["BUNDLED_SCENES", "ENV_IDS", "__version__", "register_sensorplan_envs"]

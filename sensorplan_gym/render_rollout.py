@@ -91,7 +91,10 @@ def sheet_figure(frames: list[np.ndarray], n: int, cols: int):
 
 
 def main(argv=None) -> None:
-    ap = argparse.ArgumentParser(description="Render a random-agent rollout to a PNG.")
+    ap = argparse.ArgumentParser(
+        prog="python -m sensorplan_gym.render_rollout",
+        description="Render a random-agent rollout to a PNG.",
+    )
     ap.add_argument("--env", default="sensorplan/Navigate-v0")
     ap.add_argument("--scene", default="lab")
     ap.add_argument("--out", default="rollout.png")

@@ -32,7 +32,9 @@ import json
 from pathlib import Path
 from typing import Any
 
-from ..learning.policies import make_env
+from ..checks import check_writable_dir
+from ..learning.policies import check_policies, make_env
+from .episodes import EVAL_SEED_BASE
 from .evaluate import evaluate, fresh_dir
 
 __all__ = ["DEFAULT_DIFFICULTY", "TEST_POOL_SEED", "TRAIN_POOL_SEED", "benchmark", "splits"]
@@ -102,19 +104,15 @@ def benchmark(
 
     import sensorplan_gym  # noqa: F401
 
-    from .evaluate import EVAL_SEED_BASE
-
+    check_policies(policies)  # every path, before any episode is played
+    out = check_writable_dir(
+        out if out is not None else fresh_dir(Path("runs") / f"benchmark_{env_id.split('/')[-1]}")
+    )
     base = dict(env_kwargs or {})
     probe = make_env(env_id, {k: v for k, v in base.items() if k != "scene"})
     needs_start = bool(probe.unwrapped.batch.needs_start)
     probe.close()
     sp = splits(split_names or ["train", "test", "ood"], difficulty, needs_start)
-    out = (
-        Path(out)
-        if out is not None
-        else fresh_dir(Path("runs") / f"benchmark_{env_id.split('/')[-1]}")
-    )
-    out.mkdir(parents=True, exist_ok=True)
     res: dict[str, Any] = {
         "env_id": env_id,
         "difficulty": {"min_start_distance": difficulty if needs_start else None},
@@ -156,6 +154,7 @@ def benchmark(
                     "start_distance": r["start_distance"],
                 }
             )
+    out.mkdir(parents=True, exist_ok=True)  # evaluate made it, unless no split ran
     (out / "benchmark.json").write_text(json.dumps(res, indent=1, default=str))
     with open(out / "benchmark.csv", "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=list(res["rows"][0]))

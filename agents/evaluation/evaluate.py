@@ -42,53 +42,22 @@ from typing import Any
 
 import numpy as np
 
-from ..learning.policies import load_policy, make_env, model_config, policy_label
+from ..checks import check_writable_dir
+from ..learning.policies import (
+    check_policies,
+    load_policy,
+    make_env,
+    model_config,
+    policy_label,
+)
+from .episodes import EVAL_SEED_BASE, run_episodes
+from .ray_eval import run_episodes_ray
 from .stats import iqm, normalized_score, stratified_bootstrap_ci, wilson_interval
 
 __all__ = ["EVAL_SEED_BASE", "evaluate", "format_table", "run_episodes"]
 
-#: evaluation episode ``i`` is reset with seed ``EVAL_SEED_BASE + seed + i``
-EVAL_SEED_BASE = 1_000_000
 # env kwargs that change only the reward, not what the agent sees or how the world behaves
 _REWARD_ONLY = {"shaping", "step_cost", "success_bonus"}
-
-
-def _xy(info: dict) -> np.ndarray | None:
-    pose = info.get("pose")
-    if pose is None:
-        return None
-    return np.asarray(pose[:2], dtype=float)
-
-
-def run_episodes(env, policy, seeds: list[int], *, deterministic: bool = True) -> dict[str, list]:
-    """Play one episode per seed; per-episode success, return, steps and path length."""
-    out: dict[str, list] = {"success": [], "return": [], "steps": [], "path_length": []}
-    for s in seeds:
-        obs, info = env.reset(seed=int(s))
-        state = None
-        start = np.ones(1, dtype=bool)
-        prev = _xy(info)
-        ret, steps, path = 0.0, 0, 0.0
-        done = False
-        while not done:
-            action, state = policy.predict(
-                obs, state=state, episode_start=start, deterministic=deterministic
-            )
-            start = np.zeros(1, dtype=bool)
-            obs, reward, terminated, truncated, info = env.step(action)
-            ret += float(reward)
-            steps += 1
-            xy = _xy(info)
-            if xy is not None and prev is not None:
-                path += float(np.hypot(*(xy - prev)))
-            if xy is not None:
-                prev = xy
-            done = terminated or truncated
-        out["success"].append(bool(info.get("is_success", False)))
-        out["return"].append(ret)
-        out["steps"].append(steps)
-        out["path_length"].append(path)
-    return out
 
 
 def _summary(name: str, spec: str, ep: dict[str, list], meta: dict) -> dict[str, Any]:
@@ -254,6 +223,15 @@ def evaluate(
         raise ValueError(f"episodes must be positive, got {episodes}")
     if not policies:
         raise ValueError("no policies to evaluate")
+    check_policies(policies)  # every path, before any episode is played
+    if out is not False:
+        outdir = check_writable_dir(
+            out
+            if out is not None
+            else fresh_dir(
+                Path("runs") / f"eval_{env_id.split('/')[-1].split('-v')[0].lower()}_s{seed}"
+            )
+        )
     if env_id not in gym.registry:
         raise ValueError(
             f"unknown env id {env_id!r}; sensorplan ids: {', '.join(sensorplan_gym.ENV_IDS)}"
@@ -313,8 +291,6 @@ def evaluate(
 
                 torch.manual_seed(seed)  # stochastic actions repeat exactly
             if backend == "ray":
-                from .ray_eval import run_episodes_ray
-
                 ep = run_episodes_ray(
                     env_id,
                     env_kwargs,
@@ -373,13 +349,6 @@ def evaluate(
             }
 
     if out is not False:
-        outdir = (
-            Path(out)
-            if out is not None
-            else fresh_dir(
-                Path("runs") / f"eval_{env_id.split('/')[-1].split('-v')[0].lower()}_s{seed}"
-            )
-        )
         outdir.mkdir(parents=True, exist_ok=True)
         files = {"json": str(outdir / "results.json"), "csv": str(outdir / "results.csv")}
         if plot:

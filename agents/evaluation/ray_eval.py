@@ -7,7 +7,7 @@ returns exactly what the local backend returns for the same seeds, in the same o
 
 * :func:`map_chunks` -- ``fn(job, policy, seeds_chunk)`` for every job and chunk of seeds as
   Ray tasks; the per-job results (dicts of per-episode lists) are concatenated in seed order.
-* :func:`run_episodes_ray` -- the Ray counterpart of :func:`agents.evaluation.evaluate.run_episodes`
+* :func:`run_episodes_ray` -- the Ray counterpart of :func:`agents.evaluation.episodes.run_episodes`
   for the Gymnasium envs (``sensorplan evaluate --backend ray``).
 * :func:`ensure_ray` -- connect to ``address`` (an existing cluster, e.g. ``"auto"`` or
   ``"ray://head:10001"``) or start a local instance; an already initialised Ray is reused.
@@ -20,6 +20,9 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
+from ..learning.policies import load_policy
+from .episodes import run_episodes
+
 __all__ = ["ensure_ray", "map_chunks", "run_episodes_ray"]
 
 
@@ -28,10 +31,11 @@ def ensure_ray(address: str | None = None, num_cpus: int | None = None):
     instance with ``num_cpus`` CPUs (default: all); reused when already initialised."""
     try:
         import ray
-    except ImportError as e:  # pragma: no cover - exercised without the extra
+    except ImportError as e:
         raise ImportError(
-            "the Ray backend needs Ray: pip install -e '.[multi]' (ray[rllib], pettingzoo)"
-        ) from e
+            "the Ray backend needs Ray: pip install -e '.[multi]' (ray[rllib], pettingzoo)",
+            name=e.name or "ray",
+        ) from None
     if not ray.is_initialized():
         # the workers import sensorplan-gym from their Python environment: on a cluster,
         # install the same version on every node
@@ -79,9 +83,6 @@ def _gym_chunk(job: dict[str, Any], spec: str, seeds: list[int]) -> dict[str, li
 
     import sensorplan_gym  # noqa: F401 - registers the ids
 
-    from ..learning.policies import load_policy
-    from .evaluate import run_episodes
-
     env = gym.make(job["env_id"], **job["env_kwargs"])
     try:
         policy = load_policy(spec, env, seed=job["seed"])
@@ -106,7 +107,7 @@ def run_episodes_ray(
     deterministic: bool = True,
 ) -> dict[str, list]:
     """The per-episode results of policy ``spec`` on ``env_id`` for ``seeds``, as
-    :func:`agents.evaluation.evaluate.run_episodes` gives them, computed on Ray workers.  A
+    :func:`agents.evaluation.episodes.run_episodes` gives them, computed on Ray workers.  A
     model zip path must be readable from the workers (same path on every node)."""
     job = {
         "env_id": env_id,

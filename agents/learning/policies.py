@@ -33,9 +33,11 @@ __all__ = [
     "CONTRIB_ALGOS",
     "ModelPolicy",
     "RandomPolicy",
+    "check_policies",
     "load_policy",
     "make_env",
     "model_config",
+    "model_path",
     "policy_label",
     "vecnormalize_path",
 ]
@@ -224,6 +226,52 @@ def policy_label(spec: str) -> str:
     )
 
 
+def model_path(spec: str | Path) -> Path:
+    """The model zip a policy spec names (``path/model`` also finds ``path/model.zip``).
+    Raises ``FileNotFoundError`` naming the spec when there is no such file."""
+    path = Path(spec).expanduser()
+    if path.suffix != ".zip" and not path.exists() and path.with_suffix(".zip").exists():
+        path = path.with_suffix(".zip")
+    if not path.is_file():
+        raise FileNotFoundError(
+            f"policy {str(spec)!r} is neither 'oracle', 'random' nor an existing model zip"
+        )
+    return path
+
+
+def check_policies(specs: list[str]) -> None:
+    """Check every policy spec before any episode is played: ``"oracle"``, ``"random"`` or
+    an existing zip archive (with its normalization statistics when its config says it was
+    trained on normalized observations).  Raises ``FileNotFoundError`` (a missing file) or
+    ``ValueError`` (anything else) listing every bad spec at once."""
+    import zipfile
+
+    missing, bad = [], []
+    for spec in specs:
+        if spec in ("oracle", "random"):
+            continue
+        try:
+            path = model_path(spec)
+        except FileNotFoundError as e:
+            missing.append(str(e))
+            continue
+        if not zipfile.is_zipfile(path):
+            bad.append(f"policy {spec!r}: {str(path)!r} is not a zip archive (an SB3 model)")
+            continue
+        try:
+            cfg = model_config(path) or {}
+        except ImportError:  # no yaml (rl extra): load_policy will say so
+            continue
+        if cfg.get("normalize") and not vecnormalize_path(path).is_file():
+            missing.append(
+                f"policy {spec!r} was trained with normalized observations, but their "
+                f"statistics {str(vecnormalize_path(path))!r} are missing"
+            )
+    if missing or bad:
+        msg = "; ".join(missing + bad)
+        raise (FileNotFoundError if missing and not bad else ValueError)(msg)
+
+
 def load_policy(spec: str, env, *, seed: int = 0, device: str = "cpu"):
     """A policy object for ``spec`` (``"oracle"``, ``"random"`` or a model zip), bound to
     ``env`` where that matters.  Raises ``FileNotFoundError`` for a missing zip and
@@ -234,13 +282,7 @@ def load_policy(spec: str, env, *, seed: int = 0, device: str = "cpu"):
         return OraclePolicy(env)
     if spec == "random":
         return RandomPolicy(env.action_space, seed=seed, observation_space=env.observation_space)
-    path = Path(spec)
-    if path.suffix != ".zip" and not path.exists() and path.with_suffix(".zip").exists():
-        path = path.with_suffix(".zip")
-    if not path.is_file():
-        raise FileNotFoundError(
-            f"policy {spec!r} is neither 'oracle', 'random' nor an existing model zip"
-        )
+    path = model_path(spec)
     cfg = model_config(path) or {}
     order = [cfg["algo"]] if cfg.get("algo") in ALGOS else list(ALGOS)
     errors = []

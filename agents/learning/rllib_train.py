@@ -13,7 +13,7 @@ Writes to ``--out`` (default ``runs/rllib_watch_s<seed>``): ``config.yaml`` (the
 config, with the seed and the Ray/RLlib version), ``progress.jsonl`` (one line per iteration:
 env steps, mean episode return, wall time) and ``checkpoint/`` (``algo.save``).
 :class:`RLlibWatchPolicy` loads the shared module from such a checkpoint for evaluation
-(``python -m agents.planning.watch_oracle --policy runs/.../checkpoint``).
+(``python -m agents.evaluation.watch --policy runs/.../checkpoint``).
 """
 
 from __future__ import annotations
@@ -21,11 +21,14 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import sys
 import time
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+from ..checks import absolute_path, check_writable_dir, missing_extra_message
 
 __all__ = ["ENV_NAME", "RLlibWatchPolicy", "build_config", "load_config", "train_rllib"]
 
@@ -118,8 +121,9 @@ def train_rllib(
         import ray
     except ImportError as e:
         raise ImportError(
-            "--backend rllib needs Ray RLlib and PettingZoo: pip install -e '.[multi]'"
-        ) from e
+            "--backend rllib needs Ray RLlib and PettingZoo: pip install -e '.[multi]'",
+            name=e.name or "ray",
+        ) from None
     import yaml
 
     cfg = load_config(config)
@@ -129,6 +133,7 @@ def train_rllib(
     if n_iter < 1:
         raise ValueError(f"iterations must be positive, got {n_iter}")
     outdir = Path(out) if out is not None else Path("runs") / f"rllib_watch_s{seed}"
+    check_writable_dir(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     started_here = False
     if not ray.is_initialized():
@@ -193,7 +198,7 @@ class RLlibWatchPolicy:
     themselves."""
 
     def __init__(self, checkpoint: str | Path) -> None:
-        p = Path(checkpoint)
+        p = absolute_path(checkpoint)  # RLlib reads a bare relative path as a URI
         mod = p / "learner_group" / "learner" / "rl_module" / MODULE_ID
         if not mod.is_dir():
             raise FileNotFoundError(f"no RLlib module {MODULE_ID!r} under {p} (expected {mod})")
@@ -236,14 +241,24 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--out", default=None)
     ap.add_argument("--env-kwargs", type=json.loads, default=None)
     a = ap.parse_args(argv)
-    res = train_rllib(
-        a.config,
-        seed=a.seed,
-        iterations=a.iterations,
-        address=a.address,
-        out=a.out,
-        env_kwargs=a.env_kwargs,
-    )
+    try:
+        res = train_rllib(
+            a.config,
+            seed=a.seed,
+            iterations=a.iterations,
+            address=a.address,
+            out=a.out,
+            env_kwargs=a.env_kwargs,
+        )
+    except ImportError as err:
+        msg = missing_extra_message(ap.prog, err)
+        if msg is None:
+            raise
+        print(msg, file=sys.stderr)
+        return 2
+    except (ValueError, OSError) as err:
+        print(f"{ap.prog}: error: {err}", file=sys.stderr)
+        return 2
     print(f"checkpoint: {res['checkpoint']}  ({res['wall_s']:.0f} s)")
     return 0
 

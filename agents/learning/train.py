@@ -44,7 +44,6 @@ import multiprocessing
 import os
 import platform
 import shutil
-import sys
 import time
 import warnings
 from pathlib import Path
@@ -53,6 +52,9 @@ from typing import Any
 import numpy as np
 import yaml
 
+import sensorplan_gym
+
+from ..checks import check_writable_dir
 from .policies import ALGOS, algo_class, make_env
 
 __all__ = [
@@ -83,20 +85,9 @@ _META_KEYS = (
 
 
 def package_version() -> str:
-    """The installed ``sensorplan-gym`` version (read from pyproject.toml in a checkout)."""
-    try:
-        from importlib.metadata import version
-
-        return version("sensorplan-gym")
-    except Exception:  # noqa: BLE001 - not installed: read the checkout's pyproject
-        pyproject = Path(__file__).resolve().parents[2] / "pyproject.toml"
-        try:
-            import tomllib
-
-            with open(pyproject, "rb") as f:
-                return str(tomllib.load(f)["project"]["version"])
-        except Exception:  # noqa: BLE001
-            return "unknown"
+    """The ``sensorplan-gym`` version of the code that runs (``sensorplan_gym.__version__``,
+    the one place it is written; an editable install's metadata can lag behind it)."""
+    return sensorplan_gym.__version__
 
 
 def _short(env_id: str) -> str:
@@ -368,7 +359,7 @@ def train(
         raise ValueError(f"eval_env_kwargs must be a mapping of env kwargs, got {eval_kw!r}")
     hyperparams = copy.deepcopy(hp)  # as written in the YAML, for the record
 
-    out = Path(out) if out is not None else default_out(algo, env_id, seed)
+    out = check_writable_dir(out if out is not None else default_out(algo, env_id, seed))
     if threads:
         torch.set_num_threads(int(threads))
     out.mkdir(parents=True, exist_ok=True)
@@ -597,9 +588,3 @@ def train(
             flush=True,
         )
     return record
-
-
-if __name__ == "__main__":  # pragma: no cover
-    from ..cli import main
-
-    sys.exit(main(["train", *sys.argv[1:]]))

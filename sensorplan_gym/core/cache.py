@@ -7,10 +7,10 @@ import json
 from collections import OrderedDict
 from typing import TYPE_CHECKING
 
+from .world import World, WorldConfig
+
 if TYPE_CHECKING:  # pragma: no cover
     from geometry import Scene
-
-    from .world import World, WorldConfig
 
 __all__ = ["CACHE_SIZE", "clear_cache", "get_world"]
 
@@ -21,8 +21,6 @@ _CACHE: OrderedDict[tuple, World] = OrderedDict()
 def get_world(scene: Scene, cfg: WorldConfig, data: dict | None = None) -> World:
     """The cached :class:`World` for ``(scene, cfg)`` (LRU of ``CACHE_SIZE`` entries).
     ``data``: the scene's JSON dict when the caller has it (saves a deep copy)."""
-    from .world import World
-
     key = (json.dumps(scene.to_dict() if data is None else data, sort_keys=True), cfg)
     w = _CACHE.get(key)
     if w is not None:

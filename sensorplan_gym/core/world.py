@@ -12,7 +12,8 @@ change during an episode computed once:
 * :meth:`World.batch_rows`: all of the above as padded arrays, the form in which the batched
   core (:mod:`sensorplan_gym.core.sim`) copies a world into a sub-environment's row.
 
-Worlds are cached (:func:`get_world`, :mod:`.cache`).
+Worlds are cached by :func:`sensorplan_gym.core.cache.get_world` (the cache sits above this
+module: it builds worlds, a world never reaches the cache).
 
 Target motion (``motion``)
 --------------------------
@@ -44,7 +45,6 @@ from shapely.geometry import Point
 
 from geometry import Scene, SceneError, recognizable_region
 
-from .cache import clear_cache, get_world
 from .collision import sweep
 from .queries import aim_ok_batch, region_distance_batch
 from .scenes import BUNDLED_SCENES, bundled_scene_path, load_scene
@@ -67,8 +67,6 @@ __all__ = [
     "WorldConfig",
     "boundary_segments",
     "bundled_scene_path",
-    "clear_cache",
-    "get_world",
     "load_scene",
     "segment_normals",
     "sweep",

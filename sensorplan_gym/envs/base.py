@@ -70,12 +70,13 @@ import numpy as np
 import shapely
 
 from ..core.actions import make_actions
+from ..core.cache import get_world
 from ..core.observations import make_observation
 from ..core.pool import FixedScene, shared_pool
 from ..core.rendering import HumanViewer, Renderer
 from ..core.sensor import NOISE_BOUND, RangeSensor
 from ..core.sim import BLOCK, BatchSim
-from ..core.world import World, WorldConfig, get_world, load_scene
+from ..core.world import World, WorldConfig, load_scene
 
 __all__ = ["SPEED_LIMITS", "RobotBatch", "SensorPlanBatch", "SensorPlanEnv"]
 

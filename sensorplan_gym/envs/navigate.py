@@ -30,8 +30,9 @@ Info
 Options
     ``reset(options={"start": (x, y, psi)})`` overrides the start pose (it must be free).
 Vector env
-    ``gym.make_vec("sensorplan/Navigate-v0", num_envs=N, vectorization_mode="vector_entry_point")``
-    runs N of these in one batch (:mod:`sensorplan_gym.envs.vector`).
+    ``gym.make_vec("sensorplan_gym:sensorplan/Navigate-v0", num_envs=N,
+    vectorization_mode="vector_entry_point")`` runs N of these in one batch
+    (:mod:`sensorplan_gym.envs.vector`).
 """
 
 from __future__ import annotations
@@ -196,8 +197,8 @@ class NavigateEnv(SensorPlanEnv):
     ## Arguments
     ```python
     import gymnasium as gym
-    env = gym.make("sensorplan/Navigate-v0", scene="lab", random_start=True)
-    envs = gym.make_vec("sensorplan/Navigate-v0", num_envs=64,
+    env = gym.make("sensorplan_gym:sensorplan/Navigate-v0", scene="lab", random_start=True)
+    envs = gym.make_vec("sensorplan_gym:sensorplan/Navigate-v0", num_envs=64,
                         vectorization_mode="vector_entry_point")
     ```
 

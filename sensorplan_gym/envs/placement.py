@@ -181,8 +181,8 @@ class PlacementEnv(SensorPlanEnv):
     ## Arguments
     ```python
     import gymnasium as gym
-    env = gym.make("sensorplan/Placement-v0", scene="edr", model="partial")
-    envs = gym.make_vec("sensorplan/Placement-v0", num_envs=64, scene="random",
+    env = gym.make("sensorplan_gym:sensorplan/Placement-v0", scene="edr", model="partial")
+    envs = gym.make_vec("sensorplan_gym:sensorplan/Placement-v0", num_envs=64, scene="random",
                         vectorization_mode="vector_entry_point")
     ```
 

@@ -311,8 +311,10 @@ class RecognizeEnv(SensorPlanEnv):
     ## Arguments
     ```python
     import gymnasium as gym
-    env = gym.make("sensorplan/Recognize-v0", scene="lab", map_ranges=True, declare_hold=3)
-    envs = gym.make_vec("sensorplan/Recognize-v0", num_envs=256, scene="random",
+    env = gym.make(
+        "sensorplan_gym:sensorplan/Recognize-v0", scene="lab", map_ranges=True, declare_hold=3
+    )
+    envs = gym.make_vec("sensorplan_gym:sensorplan/Recognize-v0", num_envs=256, scene="random",
                         vectorization_mode="vector_entry_point")
     ```
 

@@ -64,6 +64,7 @@ from gymnasium.utils import seeding
 from ..core.sensor import RangeSensor, Segments, cast_rays
 from ..core.world import load_scene, sweep
 from .motion import MotionConfig, Trajectory, plan_trajectory
+from .rendering import WatchRenderer
 from .world import WatchConfig, WatchWorld, get_watch_world
 
 try:  # PettingZoo is optional (extra "multi"); the env works without it
@@ -304,8 +305,6 @@ class WatchParallelEnv(_Base):
             gymnasium.logger.warn("render() called without a render_mode; pass render_mode=")
             return None
         if self._renderer is None:
-            from .rendering import WatchRenderer
-
             self._renderer = WatchRenderer()
         return self._renderer.render(self)
 

@@ -12,15 +12,39 @@ A, which the watchers' observations never do.
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from typing import Any, Protocol
 
 import numpy as np
 import shapely
 
-if TYPE_CHECKING:  # pragma: no cover
-    from .env import WatchParallelEnv
+from ..core.sensor import RangeSensor
+from .world import WatchWorld
 
-__all__ = ["WatchRenderer", "watch_region"]
+__all__ = ["WatchRenderer", "WatchView", "watch_region"]
+
+
+class WatchView(Protocol):
+    """What :meth:`WatchRenderer.render` reads of the env's state (a
+    :class:`~sensorplan_gym.multiagent.env.WatchParallelEnv` is one): the renderer sits below
+    the env and never imports it.  Poses are ``(x, y, heading)`` in the world frame (radians),
+    ``scans[i][0]`` watcher ``i``'s beam ranges, ``_a_poly`` A's outline now ((K, 2) array)."""
+
+    world: WatchWorld
+    sensor: RangeSensor
+    robot_radius: float
+    max_steps: int
+    t: int
+    traj: Any
+    trail: list
+    poses: list[tuple[float, float, float]]
+    scans: list
+    sees: list[bool]
+    declared: list[str | None]
+    _a_poly: np.ndarray
+
+    @property
+    def a_position(self) -> np.ndarray: ...
+
 
 _COLORS = ["#ff7f0e", "#9467bd", "#17becf", "#e377c2", "#8c564b", "#bcbd22"]
 
@@ -63,7 +87,8 @@ def _path(geom):
 
 
 class WatchRenderer:
-    """Draws ``width x height`` frames of a :class:`WatchParallelEnv`."""
+    """Draws ``width x height`` RGB frames (uint8 arrays ``(height, width, 3)``) of a watch
+    env's state (:class:`WatchView`)."""
 
     def __init__(self, width: int = 480, height: int = 480) -> None:
         self.width, self.height = int(width), int(height)
@@ -79,7 +104,7 @@ class WatchRenderer:
             self._fig = fig
         return self._fig
 
-    def render(self, env: WatchParallelEnv) -> np.ndarray:
+    def render(self, env: WatchView) -> np.ndarray:
         from matplotlib.patches import Circle, PathPatch, Polygon, Wedge
 
         w = env.world

@@ -4,7 +4,7 @@
     sensorplan view my_scene.json --model partial --motion stationary
     sensorplan view plan.geojson             GeoJSON and WKT scenes too (geometry.formats)
     sensorplan view lab --export view.html   one self-contained HTML file, no server
-    sensorplan view lab --rollout ep.json    adds a Replay tab (see sensorplan_gym.viewer.replay)
+    sensorplan view lab --rollout ep.json    adds a Replay tab (record one: sensorplan record)
     sensorplan view lab --root scenes/       the page may save only inside scenes/
 
 The live viewer listens on 127.0.0.1 only and serves only pages that carry its access

@@ -272,7 +272,8 @@ def _aim(layers: Layers, x: float, y: float) -> tuple[float | None, bool | None]
     full = s.fov >= 2 * math.pi - 1e-12 and layers.scene.sensor.max_range is None
     world = layers.__dict__.get("_world")
     if world is None and not full:
-        from sensorplan_gym.core.world import WorldConfig, get_world
+        from sensorplan_gym.core.cache import get_world
+        from sensorplan_gym.core.world import WorldConfig
 
         cfg = WorldConfig(
             model=s.model, motion=s.motion, eps_pos=s.eps_pos, eps_aim=s.eps_aim, fov=s.fov

@@ -1,8 +1,9 @@
 """Saved rollouts and their replay (the viewer's second tab).
 
-Record an episode to JSON::
+Record an episode to JSON (``sensorplan record`` passes the oracle, a trained model or random
+actions to :func:`record_rollout`; this module knows no agent)::
 
-    python -m sensorplan_gym.viewer.replay --env sensorplan/Recognize-v0 --policy oracle \\
+    sensorplan record --env sensorplan/Recognize-v0 --policy oracle \\
         --scene lab --seed 0 --out episode.json
     sensorplan view lab --rollout episode.json            # live app, "Replay" tab
     sensorplan view lab --rollout episode.json --export view.html   # also in the HTML file
@@ -19,10 +20,9 @@ works in the self-contained export too.
 
 from __future__ import annotations
 
-import argparse
 import json
 import math
-import sys
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -80,39 +80,49 @@ def _step_record(st: dict[str, Any], reward: float | None) -> dict[str, Any]:
 def record_rollout(
     env_id: str,
     *,
-    policy: str = "oracle",
+    policy: str | Callable[[Any], Any] = "random",
+    policy_name: str | None = None,
     seed: int = 0,
     max_steps: int | None = None,
     **env_kwargs: Any,
 ) -> dict[str, Any]:
-    """Run one episode of ``env_id`` with ``policy`` (``"oracle"`` or ``"random"``) and
-    return the rollout dictionary (see the module docstring)."""
+    """Run one episode of ``env_id`` (made with ``env_kwargs``, reset with ``seed``) and return
+    the rollout dictionary (see the module docstring).
+
+    ``policy``: ``"random"`` (the env's action space, seeded with ``seed``) or a factory called
+    once with the env that returns an object with SB3's ``predict(obs, state=None,
+    episode_start=None, deterministic=True) -> (action, state)``, e.g. ``agents.OraclePolicy``.
+    ``policy_name`` is what the file and the replay's caption call it (default ``"random"`` or
+    the factory's ``__name__``)."""
     import gymnasium as gym
 
     import sensorplan_gym  # noqa: F401
 
     from .layers import geom_to_multipolygon
 
-    if policy not in ("oracle", "random"):
-        raise ValueError(f"policy must be 'oracle' or 'random', got {policy!r}")
+    if policy != "random" and not callable(policy):
+        raise ValueError(
+            f"policy must be 'random' or a callable env -> policy (e.g. agents.OraclePolicy), "
+            f"got {policy!r}"
+        )
+    if policy_name is None:
+        policy_name = "random" if policy == "random" else getattr(policy, "__name__", "policy")
     env = gym.make(env_id, **env_kwargs)
     try:
         obs, _ = env.reset(seed=seed)
         env.action_space.seed(seed)
-        if policy == "oracle":
-            from agents.planning.oracle import OraclePolicy
-
-            oracle = OraclePolicy(env)
+        actor = None if policy == "random" else policy(env)
         world = env.unwrapped.world
         steps = [_step_record(_state(env), None)]
-        start, done, total = True, False, 0.0
+        done, total, state = False, 0.0, None
+        start = np.ones(1, dtype=bool)
         limit = max_steps if max_steps is not None else 10_000
         while not done and len(steps) <= limit:
-            if policy == "oracle":
-                action, _ = oracle.predict(obs, episode_start=start)
+            if actor is not None:
+                action, state = actor.predict(obs, state=state, episode_start=start)
             else:
                 action = env.action_space.sample()
-            start = False
+            start = np.zeros(1, dtype=bool)
             obs, r, term, trunc, info = env.step(action)
             total += r
             steps.append(_step_record(_state(env), r))
@@ -122,7 +132,7 @@ def record_rollout(
             "format": FORMAT,
             "env_id": env_id,
             "env_kwargs": {k: v for k, v in env_kwargs.items() if _jsonable(v)},
-            "policy": policy,
+            "policy": policy_name,
             "seed": seed,
             "scene": world.scene.to_dict(),
             "region": {"xs": xs, "ys": ys},
@@ -359,32 +369,3 @@ window._sp_timer = setInterval(() => {
         f"{ro.get('env_id', '')} with the {ro.get('policy', '?')} policy, seed {ro.get('seed')}"
     )
     return column(caption, row(play, slider), fig, name="replay")
-
-
-def main(argv: list[str] | None = None) -> int:
-    """Record one episode to a rollout file."""
-    ap = argparse.ArgumentParser(
-        prog="python -m sensorplan_gym.viewer.replay",
-        description="Record one episode to a rollout JSON file for `sensorplan view --rollout`.",
-    )
-    ap.add_argument("--env", default="sensorplan/Recognize-v0")
-    ap.add_argument("--policy", choices=("oracle", "random"), default="oracle")
-    ap.add_argument(
-        "--scene",
-        default="lab",
-        help="bundled scene name or scene file: scene JSON, GeoJSON or WKT (default: lab)",
-    )
-    ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--max-steps", type=int, default=None)
-    ap.add_argument("--out", default="rollout.json")
-    args = ap.parse_args(argv)
-    ro = record_rollout(
-        args.env, policy=args.policy, seed=args.seed, max_steps=args.max_steps, scene=args.scene
-    )
-    p = save_rollout(ro, args.out)
-    print(f"wrote {p}: {len(ro['steps']) - 1} steps, return {ro['return']:.3f}")
-    return 0
-
-
-if __name__ == "__main__":  # pragma: no cover
-    sys.exit(main())

@@ -9,12 +9,12 @@ import pytest
 import shapely
 
 from geometry import Scene
+from sensorplan_gym.core.cache import get_world
 from sensorplan_gym.core.sensor import RangeSensor, Segments, cast_rays
 from sensorplan_gym.core.world import (
     WorldConfig,
     boundary_segments,
     bundled_scene_path,
-    get_world,
     sweep,
 )
 

@@ -214,8 +214,9 @@ def test_batched_queries_match_each_world_in_a_mixed_pool():
 def test_rows_survive_a_larger_world():
     """Loading a world with more hull vertices enlarges the padded arrays without touching
     the other rows (each keeps its own hulls, padded by repeating its last vertex)."""
+    from sensorplan_gym.core.cache import get_world
     from sensorplan_gym.core.sim import BatchSim
-    from sensorplan_gym.core.world import WorldConfig, get_world, load_scene
+    from sensorplan_gym.core.world import WorldConfig, load_scene
 
     small = get_world(load_scene("corridor"), WorldConfig(fov=2.0))
     big = get_world(load_scene("lab"), WorldConfig(fov=2.0))

@@ -27,7 +27,7 @@ def test_ray_backends(tmp_path):
 
 
 def _watch_evaluation_matches_local():
-    from agents.planning.watch_oracle import evaluate_watch
+    from agents.evaluation.watch import evaluate_watch
 
     for policy in ("oracle", "random"):
         kw = dict(policy=policy, episodes=4, seed=3, chunk=2)
@@ -57,13 +57,15 @@ def _rllib_shared_policy_smoke(tmp_path):
     """``sensorplan train --backend rllib --address ADDR`` attaches to the running Ray
     instance (the existing-cluster path), trains 2 tiny iterations and checkpoints."""
     import json
+    import os
     import subprocess
     import sys
 
     import yaml
 
+    from agents.evaluation.watch import main as watch_main
+    from agents.evaluation.watch import run_watch_episodes
     from agents.learning.rllib_train import RLlibWatchPolicy, load_config
-    from agents.planning.watch_oracle import run_watch_episodes
 
     cfg = load_config()
     cfg["env"].update(max_steps=30, move_steps=15)
@@ -94,9 +96,18 @@ def _rllib_shared_policy_smoke(tmp_path):
     assert len(progress) == 2 and progress[-1]["env_steps"] >= 240
     saved = yaml.safe_load((out / "config.yaml").read_text())
     assert saved["address"] == address and saved["seed"] == 0
-    res = {"checkpoint": str(out / "checkpoint")}
-    policy = RLlibWatchPolicy(res["checkpoint"])
-    ep = run_watch_episodes(cfg["env"], policy, [5])
+    cwd = os.getcwd()
+    os.chdir(tmp_path)
+    try:  # a relative checkpoint path, as a user types it (pyarrow once read it as a URI)
+        policy = RLlibWatchPolicy("run/checkpoint")
+        ep = run_watch_episodes(cfg["env"], policy, [5])
+        rc = watch_main(
+            ["--scenes", "edr", "--watchers", "2", "--episodes", "1",
+             "--policy", "run/checkpoint", "--env-kwargs", json.dumps(cfg["env"])]
+        )  # fmt: skip
+    finally:
+        os.chdir(cwd)
+    assert rc == 0
     assert ep["seed"] == [5] and 0.0 <= ep["visible"][0] <= 1.0
     from sensorplan_gym import watch_v0
 

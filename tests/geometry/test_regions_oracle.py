@@ -482,10 +482,15 @@ def test_regions_agree_with_oracle_many_scenes():
 
 # agreement report: python -m tests.geometry.test_regions_oracle [--slow]
 if __name__ == "__main__":
-    import sys
+    import argparse
     import time
 
-    slow = "--slow" in sys.argv
+    ap = argparse.ArgumentParser(
+        prog="python -m tests.geometry.test_regions_oracle",
+        description="Print the agreement table of the regions with the CGAL oracle.",
+    )
+    ap.add_argument("--slow", action="store_true", help="the long run's scenes and points")
+    slow = ap.parse_args().slow
     seeds = range(N_SCENES, N_SCENES + SLOW_SCENES) if slow else range(N_SCENES)
     npts = SLOW_POINTS if slow else N_POINTS
     t0 = time.perf_counter()

@@ -321,9 +321,15 @@ def test_swept_bad_input_is_named():
 
 # python -m tests.geometry.test_swept_partial --slow [N]: the README's numbers
 if __name__ == "__main__":
-    import sys
+    import argparse
 
-    n = int(sys.argv[2]) if len(sys.argv) > 2 else 40
+    ap = argparse.ArgumentParser(
+        prog="python -m tests.geometry.test_swept_partial",
+        description="Agreement of the swept regions (3.2.2) and the recognizable region (5.2) "
+        "with the sampled oracle on N random scenes.",
+    )
+    ap.add_argument("--slow", nargs="?", type=int, const=40, default=40, metavar="N")
+    n = ap.parse_args().slow
     for what, check in (("3.2.2 swept", _check_swept), ("5.2 recognizable", _check_recognizable)):
         pool = check(range(100, 100 + n))
         print(

@@ -7,12 +7,8 @@ import numpy as np
 import pytest
 import shapely
 
-from agents.planning.watch_oracle import (
-    WatchOracle,
-    evaluate_watch,
-    format_rows,
-    run_watch_episodes,
-)
+from agents.evaluation.watch import evaluate_watch, format_rows, run_watch_episodes
+from agents.planning.watch_oracle import WatchOracle
 from sensorplan_gym import watch_v0
 from sensorplan_gym.core.world import BUNDLED_SCENES
 

@@ -283,9 +283,12 @@ def test_cli_refuses_a_bad_token_or_root(tmp_path, capsys, monkeypatch):
 
 @pytest.fixture(scope="module")
 def rollout():
+    from agents import OraclePolicy
     from sensorplan_gym.viewer.replay import record_rollout
 
-    return record_rollout("sensorplan/Recognize-v0", policy="oracle", seed=0, scene="lab")
+    return record_rollout(
+        "sensorplan/Recognize-v0", policy=OraclePolicy, policy_name="oracle", seed=0, scene="lab"
+    )
 
 
 def test_record_rollout(rollout, tmp_path):

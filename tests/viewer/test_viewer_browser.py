@@ -393,11 +393,14 @@ def test_served_app_edit_in_chromium(served, tmp_path):
 
 
 def test_replay_tab_in_exported_file(browser, tmp_path):
+    from agents import OraclePolicy
     from sensorplan_gym.core.world import load_scene
     from sensorplan_gym.viewer.export import export_html
     from sensorplan_gym.viewer.replay import record_rollout
 
-    ro = record_rollout("sensorplan/Recognize-v0", policy="oracle", seed=1, scene="lab")
+    ro = record_rollout(
+        "sensorplan/Recognize-v0", policy=OraclePolicy, policy_name="oracle", seed=1, scene="lab"
+    )
     path = export_html(load_scene("lab"), tmp_path / "view.html", rollout=ro)
     cdp = browser
     cdp.call("Page.navigate", url=path.as_uri())

@@ -21,7 +21,7 @@ from geometry.formats import load_scene_file
 from sensorplan_gym.core.world import load_scene
 from sensorplan_gym.viewer.files import OutsideRootError, confine, save_scene_confined
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 
 
 @pytest.fixture
