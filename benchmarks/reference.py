@@ -1,27 +1,57 @@
-"""The reference results of the learned baselines: train, benchmark and tabulate the grid.
+"""The reference results of the learned baselines: train, evaluate and tabulate the grid.
 
-``python -m benchmarks.reference train [--only NAME ...] [--seeds 0 1 2 3 4]``
-    trains every entry of :data:`GRID` (algorithm x env, on the procedural ``train`` pool)
-    for each seed, into ``runs/<name>_<env>_random_s<seed>``; a run whose
+The grid (:data:`GRID`) is algorithm x env entries, each trained with seeds 0-4 on the
+procedural ``train`` pool.  Every training run and every evaluation is one *cell*; cells run
+one after the other in this process (``--backend local``, the default) or as Ray tasks
+(``--backend ray``): on a local Ray instance with all CPUs (``--num-cpus N`` to limit it) or
+on an existing cluster (``--address auto`` / ``ray://head:10001``).  Each task reserves
+``--cpus-per-cell`` CPUs (default 1; training uses that many torch threads) and Ray runs as
+many as fit.  Results are written as each cell finishes, atomically, so an interrupted grid
+(a crash, Ctrl-C, a lost node) is resumed by running the same command again: finished cells
+are skipped, only the rest run.  ``BACKEND`` below stands for ``--backend ray [--address ADDR]
+[--num-cpus N] [--cpus-per-cell C] [--working-dir DIR]``.
+
+``python -m benchmarks.reference train [--only NAME ...] [--seeds 0 1 2 3 4] [BACKEND]``
+    trains every entry x seed into ``runs/<name>_<env>_random[<variant>]_s<seed>/``; a run whose
     ``final_model.zip`` exists is skipped.  Each run is exactly the ``sensorplan train``
     command that ``--print`` shows.  Hours of CPU for the whole grid; one entry and seed
-    takes minutes (README lists them).
-``python -m benchmarks.reference evaluate [--episodes 100]``
-    runs ``sensorplan benchmark`` (:func:`agents.evaluation.benchmark.benchmark`) per env on the
-    splits ``train``, ``test`` (held-out procedural scenes) and ``ood`` (every bundled scene,
-    never trained on), with the oracle, the random policy and every trained model found; results
-    in ``runs/reference/<env>[-discrete]/``.  ``--only NAME[:Env-v0] ...`` evaluates just those
-    entries' models and ``--new`` just the models not evaluated yet (into
-    ``<env>[-discrete]/models-<entry>/``; ``report`` merges them, a newer result of a model
-    replacing an older one).
-``python -m benchmarks.reference report [--update-results]``
-    the markdown table per env: success per split, the interquartile mean over training seeds
-    with its stratified-bootstrap 95 % interval (:mod:`agents.evaluation.stats`), the normalized
-    score ``(agent - random) / (oracle - random)`` on the test split and, for Navigate, the mean
-    path length over the oracle's.  The table's data (``reference.json``) and the page fragment
-    (``reference.md``) go to ``--out`` (default ``runs/benchmarks/reference/``), or with
-    ``--update-results`` to the tracked ``benchmarks/results/reference.json`` and
-    ``docs/results/reference.md``.  With no evaluated model it says so and writes nothing.
+    takes minutes.  A Ray task trains in a temporary folder of its worker and ships the run's
+    files (models, configs, normalization statistics: a few MB) back; the driver writes them
+    to ``<run>.partial/`` and renames it, so a run folder with ``final_model.zip`` is always
+    complete.
+``python -m benchmarks.reference evaluate [--episodes 100] [--only ...] [--seeds ...] [BACKEND]``
+    evaluates every finished run with ``sensorplan benchmark``
+    (:func:`agents.evaluation.benchmark.benchmark`) on the splits ``train``, ``test``
+    (held-out procedural scenes) and ``ood:<scene>`` (every bundled scene, never trained on),
+    one cell per run, plus the baselines of each env (the oracle and uniform random actions;
+    for discrete-action entries the random policy of the discrete set).  Each cell's result is
+    one small JSON file under ``--results`` (default the tracked ``benchmarks/results/reference/``,
+    see :mod:`benchmarks.reference_table`): ``<Env-v0>/<entry>/seed<k>.json`` and
+    ``<Env-v0>/oracle.json`` ...; a cell whose file exists is skipped (``--again`` evaluates
+    it again; delete one file to evaluate just that cell again).  The full benchmark output
+    (per-episode lists) of each cell goes to ``runs/reference/`` (not tracked).
+``python -m benchmarks.reference report [--results DIR] [--update-results]``
+    the markdown table per env, computed from the per-run result files alone (so it is
+    regenerated from a checkout, without ``runs/``): success per split, the interquartile
+    mean over training seeds with its stratified-bootstrap 95 % interval
+    (:mod:`agents.evaluation.stats`), the normalized score ``(agent - random) / (oracle -
+    random)`` on the test split and, for Navigate, the mean path length over the oracle's.
+    The table's data (``reference.json``) and the page fragment (``reference.md``) go to
+    ``--out`` (default ``runs/benchmarks/reference/``), or with ``--update-results`` to the
+    tracked ``benchmarks/results/reference.json`` and ``docs/results/reference.md``.  With
+    no result file it says so and writes nothing.
+
+On a cluster the workers run the cell functions (shipped with the tasks) against the
+``sensorplan_gym`` / ``agents`` / ``geometry`` packages of their own Python environment:
+install the same version of sensorplan-gym with the ``rl`` extra on every node, or pass
+``--working-dir .`` to ship this checkout as Ray's ``runtime_env`` (its dependencies must still
+be installed there).  The driver keeps the run folders and result files; the workers need no
+shared file system.
+
+The rows of runs trained before per-run results were kept (everything in the table up to this
+version) come from ``<Env-v0>/<entry>/aggregate.json``: the earlier table's row, migrated as
+it was (:func:`benchmarks.reference_table.migrate_table`).  Once an entry has a
+``seed<k>.json``, its row is computed from its per-run files only.
 
 Discrete-action agents (DQN) play the envs with ``action_type="discrete"``, where the
 analytic oracle does not run: their normalized score uses the oracle's success from the

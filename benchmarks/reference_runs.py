@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import shutil
 import tempfile
 import time
@@ -270,6 +271,13 @@ def run_cells(
     if not cells:
         return
     ray = init_ray(address, num_cpus, working_dir)
+    # the cell functions travel with the tasks (by value): the workers need the installed
+    # packages (agents, sensorplan_gym, geometry), not this benchmarks folder
+    import importlib
+
+    from ray import cloudpickle
+
+    cloudpickle.register_pickle_by_value(importlib.import_module(fn.__module__))
     task = ray.remote(fn).options(num_cpus=cpus_per_cell)
     pending = {task.remote(*args): key for key, args in cells}
     while pending:
@@ -279,4 +287,4 @@ def run_cells(
             try:
                 yield key, ray.get(ref), None
             except Exception as e:  # noqa: BLE001 - a failed task: reported, the rest go on
-                yield key, None, str(e)
+                yield key, None, re.sub(r"\x1b\[[0-9;]*m", "", str(e))

@@ -95,8 +95,8 @@ def test_reference_with_nothing_to_do_says_so(tmp_path, monkeypatch, capsys):
     from benchmarks import reference
 
     monkeypatch.chdir(tmp_path)
-    assert reference.main(["evaluate"]) == 1
+    assert reference.main(["evaluate", "--results", "res"]) == 1
     assert "nothing to evaluate" in capsys.readouterr().out
-    assert reference.main(["report"]) == 1
+    assert reference.main(["report", "--results", "res"]) == 1
     assert "nothing to report" in capsys.readouterr().err
     assert not (tmp_path / "runs" / "benchmarks").exists()
