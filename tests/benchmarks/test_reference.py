@@ -140,3 +140,70 @@ def test_install_run_replaces_unfinished_folders_only(tmp_path):
         runs.install_run(out, files)
     with pytest.raises(ValueError, match="final_model.zip"):
         runs.install_run(tmp_path / "other", {"best_model.zip": b"b"})
+
+
+_DRIVER = """
+import json, sys
+from benchmarks import reference
+e = reference.Entry(*json.loads(sys.argv[1]))
+reference.GRID[:] = [e]
+sys.exit(reference.main(sys.argv[2:]))
+"""
+
+_TINY_ARGS = [
+    "ppo",
+    "PPO",
+    reference.PLACE,
+    "ppo",
+    128,
+    {"scene": "random", "shaping": 1.0},
+    {"n_envs": 2, "n_steps": 64, "batch_size": 64, "n_epochs": 1, "eval_freq": 100_000,
+     "policy_kwargs": {"net_arch": [16]}},
+]  # fmt: skip
+
+
+def test_a_killed_grid_restarts_with_its_unfinished_runs(tmp_path, monkeypatch, capsys):
+    """``train`` killed (SIGKILL) right after its first run finished: the finished run is
+    whole and kept, a rerun trains only the others and leaves no half-written folder."""
+    import os
+    import signal
+    import subprocess
+    import sys
+
+    pytest.importorskip("stable_baselines3")
+    root = str(_results.ROOT)
+    env = {**os.environ, "PYTHONPATH": root + os.pathsep + os.environ.get("PYTHONPATH", "")}
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "driver.py").write_text(_DRIVER)
+    argv = [json.dumps(_TINY_ARGS), "train", "--seeds", "0", "1", "2"]
+    p = subprocess.Popen(
+        [sys.executable, "driver.py", *argv],
+        cwd=tmp_path,
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.DEVNULL,
+        text=True,
+    )
+    try:
+        for line in p.stdout:
+            if line.startswith("trained runs/ppo_placement_random_s0"):
+                os.kill(p.pid, signal.SIGKILL)
+                break
+    finally:
+        p.kill()
+        p.wait()
+    assert p.returncode == -signal.SIGKILL
+    tiny = reference.Entry(*_TINY_ARGS)
+    finished = [s for s in range(3) if (tiny.out(s) / "final_model.zip").is_file()]
+    assert 0 in finished and len(finished) < 3
+    assert {f.name for f in tiny.out(0).iterdir()} >= {"best_model.zip", "best_model.yaml"}
+    kept = (tiny.out(0) / "final_model.zip").stat().st_mtime_ns
+
+    monkeypatch.setattr(reference, "GRID", [tiny])
+    assert reference.main(argv[1:]) == 0
+    out = capsys.readouterr().out
+    k = len(finished)
+    assert f"{k} runs finished before, {3 - k} trained now, 0 failed" in out
+    assert all((tiny.out(s) / "final_model.zip").is_file() for s in range(3))
+    assert (tiny.out(0) / "final_model.zip").stat().st_mtime_ns == kept
+    assert not list((tmp_path / "runs").glob("*.partial"))
