@@ -2,7 +2,8 @@
 training steps) trains and evaluates as Ray tasks on a local ``ray.init(num_cpus=2)`` through
 ``python -m benchmarks.reference``'s own entry point, the report is regenerated from the
 per-run files alone, a second run does nothing, a deleted result or an unfinished run is
-redone alone, and the Ray cells give the same numbers as the in-process ones.  Skipped
+redone alone, and the Ray cells give the same numbers as the in-process ones and as a second
+driver attached to the running instance with ``--address`` (the existing-cluster path).  Skipped
 without the ``multi`` extra (Ray) or the ``rl`` extra."""
 
 from __future__ import annotations
@@ -118,6 +119,46 @@ def test_tiny_grid_on_local_ray_resumes(tmp_path, monkeypatch, capsys):
         assert got["splits"] == first[files[0]]["splits"]
         oracle = json.loads(baseline_file(local, TINY.env_id, "oracle").read_text())
         assert oracle["splits"] == first[files[2]]["splits"]
+
+        # the same cells against an existing cluster: a separate driver process attaches
+        # with --address and ships this checkout with --working-dir
+        _attached_evaluation_matches(tmp_path, first[files[0]]["splits"])
     finally:
         if started:
             ray.shutdown()
+
+
+_DRIVER = """
+import json, sys
+from benchmarks import reference
+reference.GRID[:] = [reference.Entry(*json.loads(sys.argv[1]))]
+sys.exit(reference.main(sys.argv[2:]))
+"""
+
+
+def _attached_evaluation_matches(tmp_path, want):
+    import dataclasses
+    import os
+    import subprocess
+    import sys
+
+    from benchmarks import _results
+
+    address = ray.get_runtime_context().gcs_address
+    (tmp_path / "driver.py").write_text(_DRIVER)
+    entry = [getattr(TINY, f.name) for f in dataclasses.fields(TINY)]
+    root = str(_results.ROOT)
+    env = {**os.environ, "PYTHONPATH": root + os.pathsep + os.environ.get("PYTHONPATH", "")}
+    argv = ["evaluate", "--episodes", "2", "--seeds", "0", "--results", "attached"]
+    argv += ["--backend", "ray", "--address", address, "--working-dir", root]
+    r = subprocess.run(
+        [sys.executable, "driver.py", json.dumps(entry), *argv],
+        cwd=tmp_path,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-2000:]
+    got = json.loads(run_file(tmp_path / "attached", TINY.env_id, "ppo", 0).read_text())
+    assert got["splits"] == want
