@@ -41,6 +41,11 @@ are skipped, only the rest run.  ``BACKEND`` below stands for ``--backend ray [-
     tracked ``benchmarks/results/reference.json`` and ``docs/results/reference.md``.  With
     no result file it says so and writes nothing.
 
+``python -m benchmarks.reference import OLD [--results DIR]``
+    per-run result files from the evaluations that earlier versions of this module wrote
+    under ``runs/reference/`` (``<Env-v0>[-discrete]/benchmark.json`` and
+    ``models-<entry>/benchmark.json``), for a machine that still has them.
+
 On a cluster the workers run the cell functions (shipped with the tasks) against the
 ``sensorplan_gym`` / ``agents`` / ``geometry`` packages of their own Python environment:
 install the same version of sensorplan-gym with the ``rl`` extra on every node, or pass
@@ -408,7 +413,7 @@ def evaluate_grid(
                 "seed": seed,
                 "policy": "model",
             }
-            cells.append((("run", e, s, f, spec), (spec, runs.read_run(e.out(s)))))
+            cells.append((("run", e, s, f, spec), (spec, runs.read_run(e.out(s), "best_model"))))
     for env_id, discrete in groups:
         for name in ("random-discrete",) if discrete else ("oracle", "random"):
             f = table.baseline_file(results, env_id, name)
@@ -476,6 +481,75 @@ def _run_config(run: Path) -> dict[str, Any]:
     from agents.learning.policies import model_config
 
     return model_config(str(run / "final_model.zip")) or {}
+
+
+def import_evaluations(old: Path, results: Path | None = None) -> list[Path]:
+    """Per-run result files (under ``results``, default the tracked :data:`RESULTS`) from the
+    evaluations of earlier versions of this module under ``old`` (their ``runs/reference/``:
+    ``<Env-v0>[-discrete]/benchmark.json`` and ``.../models-<entry>[.k]/benchmark.json``, a
+    newer file's result of a model replacing an older one's, as their report merged them).
+    A model is matched to its grid entry and seed by its run folder's name; its training time
+    is read from the run folder when it is there.  Returns the files written."""
+    from agents.learning.policies import model_config
+
+    results = Path(results) if results is not None else RESULTS
+    written: list[Path] = []
+    for env_id in (PLACE, REC, NAV):
+        for discrete in (False, True):
+            group = Path(old) / (env_id.split("/")[-1] + ("-discrete" if discrete else ""))
+            extra = sorted(group.glob("models-*/benchmark.json"), key=lambda f: f.stat().st_mtime)
+            files = [group / "benchmark.json"] if (group / "benchmark.json").is_file() else []
+            per: dict[str, dict[str, Any]] = {}
+            for f in files + extra:
+                b = json.loads(f.read_text())
+                evaluation = {k: b.get(k) for k in ("episodes", "seed", "difficulty")}
+                evaluation["deterministic"] = b.get("deterministic", True)
+                evaluation["env_kwargs"] = _eval_kwargs(env_id, discrete)
+                for sp, r in b["splits"].items():
+                    for p in r["policies"]:
+                        d = per.setdefault(p["spec"], {"kind": p["kind"], "splits": {}})
+                        d.update(evaluation=evaluation, source=str(f))
+                        d["splits"][sp] = runs._split_summary(p, r.get("start_distance"))
+            for spec, d in per.items():
+                common = {"evaluation": d["evaluation"], "splits": d["splits"]}
+                common["imported_from"] = d["source"]
+                if d["kind"] in ("oracle", "random"):
+                    name = "random-discrete" if discrete else d["kind"]
+                    f = table.baseline_file(results, env_id, name)
+                    rec = {"policy": d["kind"], "env_id": env_id, "discrete": discrete, **common}
+                    written.append(runs.write_json(f, rec))
+                    continue
+                run = Path(spec).parent
+                entry = next(
+                    (
+                        e
+                        for e in GRID
+                        if e.env_id == env_id
+                        and e.discrete == discrete
+                        and run.name.startswith(e.out(0).name[:-1])
+                    ),
+                    None,
+                )
+                seed = run.name.rpartition("_s")[2]
+                if entry is None or not seed.isdigit():
+                    raise SystemExit(f"{d['source']}: model {spec!r} is no run of the grid")
+                cfg = model_config(spec) if Path(spec).is_file() else None
+                rec = {
+                    "entry": entry.key,
+                    "label": entry.label,
+                    "env_id": env_id,
+                    "discrete": discrete,
+                    "seed": int(seed),
+                    "run": str(run),
+                    "command": entry.command(int(seed)),
+                    "timesteps": entry.timesteps,
+                    "train_time_s": (cfg or {}).get("train_time_s"),
+                    "versions": (cfg or {}).get("versions"),
+                    **common,
+                }
+                f = table.run_file(results, env_id, entry.key, int(seed))
+                written.append(runs.write_json(f, rec))
+    return written
 
 
 def report_data(results: Path | None = None) -> dict[str, Any]:
@@ -563,7 +637,17 @@ def main(argv: list[str] | None = None) -> int:
         help=f"the per-run result files (default the tracked {RESULTS.relative_to(ROOT)})",
     )
     _results.add_output_args(rp, "reference")
+    im = sub.add_parser(
+        "import",
+        help="per-run result files from the evaluations of earlier versions (runs/reference/)",
+    )
+    im.add_argument("old", type=Path, help="the runs/reference/ folder of an earlier version")
+    im.add_argument("--results", type=Path, default=RESULTS)
     args = ap.parse_args(argv)
+    if args.cmd == "import":
+        written = import_evaluations(args.old, args.results)
+        print(f"wrote {len(written)} result files under {args.results}")
+        return 0 if written else 1
     if args.cmd == "train":
         entries = _selected(args.only)
         if args.print:

@@ -74,14 +74,16 @@ def write_json(path: Path, data: Any) -> Path:
     return path
 
 
-def read_run(folder: Path) -> dict[str, bytes]:
-    """The files of a run folder (:data:`RUN_FILES`, top level only) as ``{name: bytes}``."""
+def read_run(folder: Path, model: str | None = None) -> dict[str, bytes]:
+    """The files of a run folder (:data:`RUN_FILES`, top level only) as ``{name: bytes}``;
+    ``model`` (e.g. ``"best_model"``): only that model's files (its zip, resolved config and
+    normalization statistics), what an evaluation needs."""
     folder = Path(folder)
     return {
         p.name: p.read_bytes()
         for pattern in RUN_FILES
         for p in sorted(folder.glob(pattern))
-        if p.is_file()
+        if p.is_file() and (model is None or p.stem == model or p.name.startswith(model + "_"))
     }
 
 

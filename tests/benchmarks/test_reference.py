@@ -207,3 +207,48 @@ def test_a_killed_grid_restarts_with_its_unfinished_runs(tmp_path, monkeypatch, 
     assert all((tiny.out(s) / "final_model.zip").is_file() for s in range(3))
     assert (tiny.out(0) / "final_model.zip").stat().st_mtime_ns == kept
     assert not list((tmp_path / "runs").glob("*.partial"))
+
+
+def test_import_of_earlier_evaluations(tmp_path, monkeypatch):
+    """The evaluations of earlier versions (runs/reference/<Env>/benchmark.json and the
+    incremental models-<entry>/benchmark.json) become per-run files; a newer file's result
+    of a model replaces an older one's, as the earlier report merged them."""
+    import os
+
+    monkeypatch.chdir(tmp_path)
+    ppo = next(e for e in reference.GRID if e.key == "ppo" and e.env_id == reference.PLACE)
+    sac = next(e for e in reference.GRID if e.key == "sac" and e.env_id == reference.PLACE)
+
+    def pol(kind, spec, sr):
+        return {"kind": kind, "spec": spec, **_split(sr)}
+
+    def spec(e, s):
+        return str(e.out(s) / "best_model.zip")
+
+    def bench(policies):
+        return {"episodes": 100, "seed": 0, "difficulty": {"min_start_distance": None},
+                "splits": {"test": {"policies": policies, "start_distance": None}}}  # fmt: skip
+
+    old = tmp_path / "runs" / "reference" / "Placement-v0"
+    (old / "models-sac").mkdir(parents=True)
+    full = [pol("oracle", "oracle", 1.0), pol("random", "random", 0.2)]
+    full += [pol("model", spec(ppo, s), 0.5) for s in range(2)]
+    (old / "benchmark.json").write_text(json.dumps(bench(full)))
+    newer = [pol("model", spec(sac, s), 0.9) for s in range(3)]
+    newer.append(pol("model", spec(ppo, 1), 0.7))  # evaluated again: replaces 0.5
+    f = old / "models-sac" / "benchmark.json"
+    f.write_text(json.dumps(bench(newer)))
+    t = (old / "benchmark.json").stat().st_mtime
+    os.utime(f, (t + 10, t + 10))
+    res = tmp_path / "res"
+    assert reference.main(["import", str(old.parent), "--results", str(res)]) == 0
+    assert json.loads(table.run_file(res, ppo.env_id, "ppo", 1).read_text())["seed"] == 1
+    text = reference.report(res)
+    rows = {
+        line.split("|")[1].strip(): [c.strip() for c in line.strip("|").split("|")]
+        for line in text.splitlines()
+        if line.startswith("| ")
+    }
+    assert rows["SAC"][1] == "3" and rows["SAC"][3].startswith("0.90 [")
+    assert rows["PPO"][1] == "2" and rows["PPO"][3].startswith("0.60 [")  # IQM of 0.5, 0.7
+    assert "| oracle | — | — | 1.00 |" in text and "| random | — | — | 0.20 |" in text
