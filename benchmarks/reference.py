@@ -1,27 +1,62 @@
-"""The reference results of the learned baselines: train, benchmark and tabulate the grid.
+"""The reference results of the learned baselines: train, evaluate and tabulate the grid.
 
-``python -m benchmarks.reference train [--only NAME ...] [--seeds 0 1 2 3 4]``
-    trains every entry of :data:`GRID` (algorithm x env, on the procedural ``train`` pool)
-    for each seed, into ``runs/<name>_<env>_random_s<seed>``; a run whose
+The grid (:data:`GRID`) is algorithm x env entries, each trained with seeds 0-4 on the
+procedural ``train`` pool.  Every training run and every evaluation is one *cell*; cells run
+one after the other in this process (``--backend local``, the default) or as Ray tasks
+(``--backend ray``): on a local Ray instance with all CPUs (``--num-cpus N`` to limit it) or
+on an existing cluster (``--address auto`` / ``ray://head:10001``).  Each task reserves
+``--cpus-per-cell`` CPUs (default 1; training uses that many torch threads) and Ray runs as
+many as fit.  Results are written as each cell finishes, atomically, so an interrupted grid
+(a crash, Ctrl-C, a lost node) is resumed by running the same command again: finished cells
+are skipped, only the rest run.  ``BACKEND`` below stands for ``--backend ray [--address ADDR]
+[--num-cpus N] [--cpus-per-cell C] [--working-dir DIR]``.
+
+``python -m benchmarks.reference train [--only NAME ...] [--seeds 0 1 2 3 4] [BACKEND]``
+    trains every entry x seed into ``runs/<name>_<env>_random[<variant>]_s<seed>/``; a run whose
     ``final_model.zip`` exists is skipped.  Each run is exactly the ``sensorplan train``
     command that ``--print`` shows.  Hours of CPU for the whole grid; one entry and seed
-    takes minutes (README lists them).
-``python -m benchmarks.reference evaluate [--episodes 100]``
-    runs ``sensorplan benchmark`` (:func:`agents.evaluation.benchmark.benchmark`) per env on the
-    splits ``train``, ``test`` (held-out procedural scenes) and ``ood`` (every bundled scene,
-    never trained on), with the oracle, the random policy and every trained model found; results
-    in ``runs/reference/<env>[-discrete]/``.  ``--only NAME[:Env-v0] ...`` evaluates just those
-    entries' models and ``--new`` just the models not evaluated yet (into
-    ``<env>[-discrete]/models-<entry>/``; ``report`` merges them, a newer result of a model
-    replacing an older one).
-``python -m benchmarks.reference report [--update-results]``
-    the markdown table per env: success per split, the interquartile mean over training seeds
-    with its stratified-bootstrap 95 % interval (:mod:`agents.evaluation.stats`), the normalized
-    score ``(agent - random) / (oracle - random)`` on the test split and, for Navigate, the mean
-    path length over the oracle's.  The table's data (``reference.json``) and the page fragment
-    (``reference.md``) go to ``--out`` (default ``runs/benchmarks/reference/``), or with
-    ``--update-results`` to the tracked ``benchmarks/results/reference.json`` and
-    ``docs/results/reference.md``.  With no evaluated model it says so and writes nothing.
+    takes minutes.  A Ray task trains in a temporary folder of its worker and ships the run's
+    files (models, configs, normalization statistics: a few MB) back; the driver writes them
+    to ``<run>.partial/`` and renames it, so a run folder with ``final_model.zip`` is always
+    complete.
+``python -m benchmarks.reference evaluate [--episodes 100] [--only ...] [--seeds ...] [BACKEND]``
+    evaluates every finished run with ``sensorplan benchmark``
+    (:func:`agents.evaluation.benchmark.benchmark`) on the splits ``train``, ``test``
+    (held-out procedural scenes) and ``ood:<scene>`` (every bundled scene, never trained on),
+    one cell per run, plus the baselines of each env (the oracle and uniform random actions;
+    for discrete-action entries the random policy of the discrete set).  Each cell's result is
+    one small JSON file under ``--results`` (default the tracked ``benchmarks/results/reference/``,
+    see :mod:`benchmarks.reference_table`): ``<Env-v0>/<entry>/seed<k>.json`` and
+    ``<Env-v0>/oracle.json`` ...; a cell whose file exists is skipped (``--again`` evaluates
+    it again; delete one file to evaluate just that cell again).  The full benchmark output
+    (per-episode lists) of each cell goes to ``runs/reference/`` (not tracked).
+``python -m benchmarks.reference report [--results DIR] [--update-results]``
+    the markdown table per env, computed from the per-run result files alone (so it is
+    regenerated from a checkout, without ``runs/``): success per split, the interquartile
+    mean over training seeds with its stratified-bootstrap 95 % interval
+    (:mod:`agents.evaluation.stats`), the normalized score ``(agent - random) / (oracle -
+    random)`` on the test split and, for Navigate, the mean path length over the oracle's.
+    The table's data (``reference.json``) and the page fragment (``reference.md``) go to
+    ``--out`` (default ``runs/benchmarks/reference/``), or with ``--update-results`` to the
+    tracked ``benchmarks/results/reference.json`` and ``docs/results/reference.md``.  With
+    no result file it says so and writes nothing.
+
+``python -m benchmarks.reference import OLD [--results DIR]``
+    per-run result files from the evaluations that earlier versions of this module wrote
+    under ``runs/reference/`` (``<Env-v0>[-discrete]/benchmark.json`` and
+    ``models-<entry>/benchmark.json``), for a machine that still has them.
+
+On a cluster the workers run the cell functions (shipped with the tasks) against the
+``sensorplan_gym`` / ``agents`` / ``geometry`` packages of their own Python environment:
+install the same version of sensorplan-gym with the ``rl`` extra on every node, or pass
+``--working-dir .`` to ship this checkout as Ray's ``runtime_env`` (its dependencies must still
+be installed there).  The driver keeps the run folders and result files; the workers need no
+shared file system.
+
+The rows of runs trained before per-run results were kept (everything in the table up to this
+version) come from ``<Env-v0>/<entry>/aggregate.json``: the earlier table's row, migrated as
+it was (:func:`benchmarks.reference_table.migrate_table`).  Once an entry has a
+``seed<k>.json``, its row is computed from its per-run files only.
 
 Discrete-action agents (DQN) play the envs with ``action_type="discrete"``, where the
 analytic oracle does not run: their normalized score uses the oracle's success from the
@@ -38,17 +73,19 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from . import _results
+from . import reference_runs as runs
+from . import reference_table as table
 
 NAV = "sensorplan/Navigate-v0"
 REC = "sensorplan/Recognize-v0"
 PLACE = "sensorplan/Placement-v0"
 RUNS = Path("runs")
+#: the full benchmark output of each evaluated cell (not tracked)
 OUT = RUNS / "reference"
-#: the tracked page fragment (with its data, benchmarks/results/reference.json)
-TRACKED = _results.FRAGMENT_DIR / "reference.md"
+ROOT = _results.ROOT
+#: the per-run result files the table is made from (tracked)
+RESULTS = ROOT / "benchmarks" / "results" / "reference"
 SEEDS = (0, 1, 2, 3, 4)
 
 #: training env kwargs per env: the procedural train pool at the benchmark's difficulty
@@ -261,62 +298,80 @@ def _selected(only: list[str] | None) -> list[Entry]:
     return [e for e in GRID if e.key in only or f"{e.key}:{e.env_id.split('/')[-1]}" in only]
 
 
-def train_grid(entries: list[Entry], seeds: list[int]) -> None:
-    """Train every entry x seed whose final model is missing (the commands of ``--print``)."""
-    from agents.cli import _hp_overrides
-    from agents.learning.train import train
+def _backend(args: argparse.Namespace) -> dict[str, Any]:
+    return {
+        "backend": args.backend,
+        "address": args.address,
+        "num_cpus": args.num_cpus,
+        "cpus_per_cell": args.cpus_per_cell,
+        "working_dir": args.working_dir,
+    }
 
+
+def _train_spec(e: Entry, seed: int, threads: int) -> dict[str, Any]:
+    return {
+        "env_id": e.env_id,
+        "algo": e.algo,
+        "timesteps": e.timesteps,
+        "seed": int(seed),
+        "env_kwargs": e.env_kwargs,
+        "hp": _hp(e),
+        "config": e.config,
+        "threads": threads,
+    }
+
+
+def _hp(e: Entry) -> dict[str, Any]:
+    """The entry's hyperparameter overrides as ``sensorplan train --hp`` reads them."""
+    from agents.cli import _hp_overrides
+
+    return _hp_overrides([f"{k}={json.dumps(v)}" for k, v in e.hp.items()]) if e.hp else {}
+
+
+def train_grid(
+    entries: list[Entry], seeds: list[int], **backend: Any
+) -> tuple[int, int, list[str]]:
+    """Train every entry x seed whose final model is missing (the commands of ``--print``),
+    one cell per run; ``backend``: the keywords of
+    :func:`benchmarks.reference_runs.run_cells` (``backend="ray"``: one Ray task per run,
+    ``cpus_per_cell`` CPUs each).  Each finished run is written to ``runs/<...>_s<seed>/`` as
+    it finishes (atomically), so an interrupted grid restarts with the unfinished runs only.
+    Returns ``(runs already finished, runs trained, failures)``."""
+    done, todo = 0, []
     for e in entries:
         for s in seeds:
             if (e.out(s) / "final_model.zip").is_file():
                 print(f"skip {e.out(s)} (trained)", flush=True)
-                continue
-            print(e.command(s), flush=True)
-            hp = _hp_overrides([f"{k}={json.dumps(v)}" for k, v in e.hp.items()]) if e.hp else {}
-            train(
-                e.env_id,
-                e.algo,
-                timesteps=e.timesteps,
-                seed=s,
-                env_kwargs=e.env_kwargs,
-                config=e.config,
-                out=e.out(s),
-                hp_overrides=hp,
-                tensorboard=False,
-                progress_bar=False,
-            )
+                done += 1
+            else:
+                todo.append((e, s))
+    threads = max(1, int(backend.get("cpus_per_cell") or 1))
+    cells = [((e, s), (_train_spec(e, s, threads),)) for e, s in todo]
+    for e, s in todo:
+        print(e.command(s), flush=True)
+    trained, failed = 0, []
+    for (e, s), res, err in runs.run_cells(runs.train_cell, cells, **backend):
+        if err is not None:
+            failed.append(f"{e.out(s)}: {err}")
+            print(f"FAILED {e.out(s)}:\n{err}", flush=True)
+            continue
+        runs.install_run(e.out(s), res["files"])
+        trained += 1
+        print(f"trained {e.out(s)} in {res['train_time_s']:.0f} s on {res['host']}", flush=True)
+    return done, trained, failed
 
 
-def _models(entries: list[Entry]) -> list[str]:
-    """The best models of the finished runs (``final_model.zip`` written) of ``entries``."""
+def _trained_seeds(e: Entry, seeds: list[int] | None) -> list[int]:
+    """The seeds of ``e`` whose run finished (``final_model.zip`` and ``best_model.zip``)."""
     return [
-        str(e.out(s) / "best_model.zip")
-        for e in entries
-        for s in range(100)
+        s
+        for s in (seeds if seeds is not None else range(100))
         if (e.out(s) / "best_model.zip").is_file() and (e.out(s) / "final_model.zip").is_file()
     ]
 
 
-def _group_dir(env_id: str, discrete: bool) -> Path:
-    return OUT / (env_id.split("/")[-1] + ("-discrete" if discrete else ""))
-
-
-def _result_files(env_id: str, discrete: bool) -> list[Path]:
-    """The benchmark results of one env and action type, oldest first: the full evaluation
-    (``<group>/benchmark.json``, with the baselines) and the incremental ones of
-    ``evaluate --only`` (``<group>/models-<entry>/benchmark.json``)."""
-    g = _group_dir(env_id, discrete)
-    extra = sorted(g.glob("models-*/benchmark.json"), key=lambda f: f.stat().st_mtime)
-    return ([g / "benchmark.json"] if (g / "benchmark.json").is_file() else []) + extra
-
-
-def _evaluated(env_id: str, discrete: bool) -> set[str]:
-    return {
-        p["spec"]
-        for f in _result_files(env_id, discrete)
-        for r in json.loads(f.read_text())["splits"].values()
-        for p in r["policies"]
-    }
+def _eval_kwargs(env_id: str, discrete: bool) -> dict[str, Any]:
+    return dict(EVAL_KWARGS[env_id], **({"action_type": "discrete"} if discrete else {}))
 
 
 def evaluate_grid(
@@ -324,227 +379,275 @@ def evaluate_grid(
     seed: int = 0,
     envs: list[str] | None = None,
     only: list[Entry] | None = None,
-    new: bool = False,
-) -> tuple[int, int]:
-    """``sensorplan benchmark`` per env (and per action type) with every trained model;
-    ``envs``: only these env ids.  ``only``: only these entries' models, without the
-    baselines, into ``<group>/models-<entry>/`` (:func:`report` merges them; a model's
-    episodes do not depend on which other policies are evaluated with it); ``new``: only
-    models not evaluated yet.  Returns ``(models found, models evaluated)``."""
-    from agents.evaluation.benchmark import benchmark
-
-    found = evaluated = 0
-    for env_id in envs or (PLACE, REC, NAV):
-        for discrete in (False, True):
-            entries = [e for e in GRID if e.env_id == env_id and e.discrete == discrete]
-            kw = dict(EVAL_KWARGS[env_id], **({"action_type": "discrete"} if discrete else {}))
-            done = _evaluated(env_id, discrete) if new else set()
-            if only is None and not new:
-                models = _models(entries)
-                found += len(models)
-                evaluated += len(models)
-                if models:
-                    base = ["random"] if discrete else ["oracle", "random"]
-                    benchmark(
-                        env_id,
-                        base + models,
-                        episodes=episodes,
-                        seed=seed,
-                        env_kwargs=kw,
-                        out=_group_dir(env_id, discrete),
-                    )
+    seeds: list[int] | None = None,
+    again: bool = False,
+    results: Path | None = None,
+    **backend: Any,
+) -> tuple[int, int, list[str]]:
+    """Evaluate every finished run of the selected entries (``only``, or the whole grid;
+    ``envs``: only these env ids; ``seeds``: only these training seeds) and the baselines of
+    their envs (oracle and random, or the random policy of the discrete action set) with
+    :func:`agents.evaluation.benchmark.benchmark` on every split, one cell per run and
+    baseline; each result is written to its file under ``results`` (default the tracked
+    :data:`RESULTS`) as it finishes.  A cell whose result file exists is skipped unless
+    ``again``.  The full benchmark output of each cell goes to ``runs/reference/`` (not
+    tracked).  Returns ``(finished runs found, cells evaluated, failures)``."""
+    results = Path(results) if results is not None else RESULTS
+    chosen = [e for e in (only if only is not None else GRID) if envs is None or e.env_id in envs]
+    cells: list[tuple[tuple, tuple]] = []
+    found = 0
+    groups: list[tuple[str, bool]] = []
+    for e in chosen:
+        trained = _trained_seeds(e, seeds)
+        found += len(trained)
+        if trained and (e.env_id, e.discrete) not in groups:
+            groups.append((e.env_id, e.discrete))
+        for s in trained:
+            f = table.run_file(results, e.env_id, e.key, s)
+            if f.is_file() and not again:
                 continue
-            for e in entries:
-                if only is not None and e not in only:
-                    continue
-                every = _models([e])
-                models = [m for m in every if m not in done]
-                found += len(every)
-                evaluated += len(models)
-                if models:
-                    benchmark(
-                        env_id,
-                        models,
-                        episodes=episodes,
-                        seed=seed,
-                        env_kwargs=kw,
-                        out=_models_dir(_group_dir(env_id, discrete), e.key, new),
-                    )
-    return found, evaluated
+            spec = {
+                "env_id": e.env_id,
+                "env_kwargs": _eval_kwargs(e.env_id, e.discrete),
+                "episodes": episodes,
+                "seed": seed,
+                "policy": "model",
+            }
+            cells.append((("run", e, s, f, spec), (spec, runs.read_run(e.out(s), "best_model"))))
+    for env_id, discrete in groups:
+        for name in ("random-discrete",) if discrete else ("oracle", "random"):
+            f = table.baseline_file(results, env_id, name)
+            if f.is_file() and not again and "splits" in json.loads(f.read_text()):
+                continue  # evaluated (a migrated baseline is evaluated again)
+            spec = {
+                "env_id": env_id,
+                "env_kwargs": _eval_kwargs(env_id, discrete),
+                "episodes": episodes,
+                "seed": seed,
+                "policy": name.split("-")[0],
+            }
+            cells.append((("baseline", name, discrete, f, spec), (spec, None)))
+    evaluated, failed = 0, []
+    for key, res, err in runs.run_cells(runs.evaluate_cell, cells, **backend):
+        kind, f, spec = key[0], key[3], key[4]
+        if err is not None:
+            failed.append(f"{f}: {err}")
+            print(f"FAILED {f}:\n{err}", flush=True)
+            continue
+        evaluation = {
+            "episodes": spec["episodes"],
+            "seed": spec["seed"],
+            "env_kwargs": spec["env_kwargs"],
+            "difficulty": res["benchmark"]["difficulty"],
+            "deterministic": res["benchmark"]["deterministic"],
+        }
+        if kind == "run":
+            e, s = key[1], key[2]
+            cfg = _run_config(e.out(s))
+            rec = {
+                "entry": e.key,
+                "label": e.label,
+                "env_id": e.env_id,
+                "discrete": e.discrete,
+                "seed": s,
+                "run": str(e.out(s)),
+                "command": e.command(s),
+                "timesteps": e.timesteps,
+                "train_time_s": cfg.get("train_time_s"),
+                "versions": cfg.get("versions"),
+                "evaluation": evaluation,
+                "splits": res["splits"],
+            }
+            detail = OUT / e.env_id.split("/")[-1] / e.key / f"seed{s}.benchmark.json"
+        else:
+            name, discrete = key[1], key[2]
+            rec = {
+                "policy": spec["policy"],
+                "env_id": spec["env_id"],
+                "discrete": discrete,
+                "evaluation": evaluation,
+                "splits": res["splits"],
+            }
+            detail = OUT / spec["env_id"].split("/")[-1] / f"{name}.benchmark.json"
+        runs.write_json(f, rec)
+        runs.write_json(detail, res["benchmark"])
+        evaluated += 1
+        print(f"evaluated -> {f} (on {res['host']})", flush=True)
+    return found, evaluated, failed
 
 
-def _models_dir(group: Path, key: str, new: bool) -> Path:
-    """Where ``evaluate --only/--new`` writes one entry's models: ``models-<key>``; with
-    ``new`` (only some of the entry's models) the first of ``models-<key>``,
-    ``models-<key>.2``, ... without results, so that no earlier result is overwritten."""
-    d, k = group / f"models-{key}", 1
-    while new and (d / "benchmark.json").is_file():
-        k += 1
-        d = group / f"models-{key}.{k}"
-    return d
-
-
-def _cell(rates: list[float], seed: int = 0) -> dict[str, Any] | None:
-    """The IQM over training seeds with its stratified-bootstrap 95 % interval (``n`` seeds);
-    one seed: its value; none: ``None``."""
-    from agents.evaluation.stats import iqm, stratified_bootstrap_ci
-
-    if not rates:
-        return None
-    if len(rates) == 1:
-        return {"n": 1, "est": float(rates[0])}
-    est, lo, hi = stratified_bootstrap_ci(np.array([[r] for r in rates]), iqm, seed=seed)
-    return {"n": len(rates), "est": float(est), "lo": float(lo), "hi": float(hi)}
-
-
-def _fmt_cell(c: dict[str, Any] | None) -> str:
-    if c is None:
-        return "—"
-    if c["n"] == 1:
-        return f"{c['est']:.2f} (1 seed)"
-    return f"{c['est']:.2f} [{c['lo']:.2f}, {c['hi']:.2f}]"
-
-
-def report_data() -> dict[str, Any]:
-    """The tables' data of the evaluated grid (``runs/reference``): per env the splits and one
-    row per baseline and per grid entry."""
+def _run_config(run: Path) -> dict[str, Any]:
+    """The resolved training config of a finished run (``final_model.yaml``)."""
     from agents.learning.policies import model_config
 
-    out: dict[str, Any] = {"envs": []}
+    return model_config(str(run / "final_model.zip")) or {}
+
+
+def import_evaluations(old: Path, results: Path | None = None) -> list[Path]:
+    """Per-run result files (under ``results``, default the tracked :data:`RESULTS`) from the
+    evaluations of earlier versions of this module under ``old`` (their ``runs/reference/``:
+    ``<Env-v0>[-discrete]/benchmark.json`` and ``.../models-<entry>[.k]/benchmark.json``, a
+    newer file's result of a model replacing an older one's, as their report merged them).
+    A model is matched to its grid entry and seed by its run folder's name; its training time
+    is read from the run folder when it is there.  Returns the files written."""
+    from agents.learning.policies import model_config
+
+    results = Path(results) if results is not None else RESULTS
+    written: list[Path] = []
     for env_id in (PLACE, REC, NAV):
-        rows: dict[str, dict] = {}
-        splits: list[str] = []
-        base: dict[tuple[str, str], float] = {}
-        path: dict[tuple[str, str], float] = {}
         for discrete in (False, True):
-            merged: dict[str, dict] = {}  # split -> spec -> policy result (latest file wins)
-            for f in _result_files(env_id, discrete):
-                for sp, r in json.loads(f.read_text())["splits"].items():
-                    if sp not in splits:
-                        splits.append(sp)
+            group = Path(old) / (env_id.split("/")[-1] + ("-discrete" if discrete else ""))
+            extra = sorted(group.glob("models-*/benchmark.json"), key=lambda f: f.stat().st_mtime)
+            files = [group / "benchmark.json"] if (group / "benchmark.json").is_file() else []
+            per: dict[str, dict[str, Any]] = {}
+            for f in files + extra:
+                b = json.loads(f.read_text())
+                evaluation = {k: b.get(k) for k in ("episodes", "seed", "difficulty")}
+                evaluation["deterministic"] = b.get("deterministic", True)
+                evaluation["env_kwargs"] = _eval_kwargs(env_id, discrete)
+                for sp, r in b["splits"].items():
                     for p in r["policies"]:
-                        merged.setdefault(sp, {})[p["spec"]] = p
-            for sp, by_spec in merged.items():
-                for p in by_spec.values():
-                    if p["kind"] in ("oracle", "random"):
-                        key = p["kind"] + (" (discrete)" if discrete else "")
-                        base[(key, sp)] = p["success_rate"]
-                        path[(key, sp)] = p["mean_path_length"]
-                        rows.setdefault(key, {"n": 1})
-                        continue
-                    entry = next(
-                        (
-                            e
-                            for e in GRID
-                            if e.env_id == env_id
-                            and Path(p["spec"]).parent.name.startswith(e.out(0).name[:-1])
-                        ),
-                        None,
-                    )
-                    label = entry.label if entry else Path(p["spec"]).parent.name
-                    row = rows.setdefault(label, {"n": 0, "discrete": discrete, "runs": set()})
-                    if p["spec"] not in row["runs"]:
-                        cfg = model_config(p["spec"]) or {}
-                        row.setdefault("time", []).append(cfg.get("train_time_s"))
-                    row["runs"].add(p["spec"])
-                    row.setdefault(sp, []).append(p["success_rate"])
-                    row.setdefault(f"path:{sp}", []).append(p["mean_path_length"])
-        if not rows:
-            continue
-        table: dict[str, Any] = {"env": env_id.split("/")[-1], "splits": splits, "rows": []}
-        for label, row in rows.items():
-            if label in ("oracle", "random", "random (discrete)"):
-                o = path.get(("oracle", "test"))
-                p_ = path.get((label, "test"))
-                table["rows"].append(
-                    {
-                        "label": label,
-                        "baseline": True,
-                        "success": {sp: base.get((label, sp)) for sp in splits},
-                        "normalized": 1.0 if label == "oracle" else 0.0,
-                        "path_ratio": p_ / o if o and p_ is not None else None,
-                    }
+                        d = per.setdefault(p["spec"], {"kind": p["kind"], "splits": {}})
+                        d.update(evaluation=evaluation, source=str(f))
+                        d["splits"][sp] = runs._split_summary(p, r.get("start_distance"))
+            for spec, d in per.items():
+                common = {"evaluation": d["evaluation"], "splits": d["splits"]}
+                common["imported_from"] = d["source"]
+                if d["kind"] in ("oracle", "random"):
+                    name = "random-discrete" if discrete else d["kind"]
+                    f = table.baseline_file(results, env_id, name)
+                    rec = {"policy": d["kind"], "env_id": env_id, "discrete": discrete, **common}
+                    written.append(runs.write_json(f, rec))
+                    continue
+                run = Path(spec).parent
+                entry = next(
+                    (
+                        e
+                        for e in GRID
+                        if e.env_id == env_id
+                        and e.discrete == discrete
+                        and run.name.startswith(e.out(0).name[:-1])
+                    ),
+                    None,
                 )
-                continue
-            rnd = "random (discrete)" if row["discrete"] else "random"
-            times = [t for t in row.get("time", []) if t is not None]
-            o, r0 = base.get(("oracle", "test"), 1.0), base.get((rnd, "test"))
-            norm = None
-            if r0 is not None and o > r0 and row.get("test"):
-                norm = _cell([(x - r0) / (o - r0) for x in row["test"]])
-            op = path.get(("oracle", "test"))
-            ps = row.get("path:test", [])
-            table["rows"].append(
-                {
-                    "label": label,
-                    "baseline": False,
-                    "seeds": len(row["runs"]),
-                    "train_min": float(np.median(times) / 60) if times else None,
-                    "success": {sp: _cell(row.get(sp, [])) for sp in splits},
-                    "normalized": norm,
-                    "path_ratio": float(np.median(ps) / op) if op and ps else None,
+                seed = run.name.rpartition("_s")[2]
+                if entry is None or not seed.isdigit():
+                    raise SystemExit(f"{d['source']}: model {spec!r} is no run of the grid")
+                cfg = model_config(spec) if Path(spec).is_file() else None
+                rec = {
+                    "entry": entry.key,
+                    "label": entry.label,
+                    "env_id": env_id,
+                    "discrete": discrete,
+                    "seed": int(seed),
+                    "run": str(run),
+                    "command": entry.command(int(seed)),
+                    "timesteps": entry.timesteps,
+                    "train_time_s": (cfg or {}).get("train_time_s"),
+                    "versions": (cfg or {}).get("versions"),
+                    **common,
                 }
-            )
-        out["envs"].append(table)
-    return out
+                f = table.run_file(results, env_id, entry.key, int(seed))
+                written.append(runs.write_json(f, rec))
+    return written
+
+
+def report_data(results: Path | None = None) -> dict[str, Any]:
+    """The tables' data from the per-run result files under ``results`` (default the tracked
+    :data:`RESULTS`) alone: per env the splits and one row per baseline and per grid entry
+    (:func:`benchmarks.reference_table.report_data`)."""
+    return table.report_data(
+        results if results is not None else RESULTS, GRID, envs=(PLACE, REC, NAV)
+    )
 
 
 def render(data: dict[str, Any]) -> str:
     """The markdown table per env of :func:`report_data`'s data."""
-    out = []
-    for t in data["envs"]:
-        nav = t["env"] == NAV.split("/")[-1]
-        splits = t["splits"]
-        head = ["agent", "seeds", "train time / seed", *splits, "normalized (test)"]
-        if nav:
-            head.append("path / oracle (test)")
-        lines = [f"**{t['env']}**", "", "| " + " | ".join(head) + " |"]
-        lines.append("| " + " | ".join(["---"] * len(head)) + " |")
-        for r in t["rows"]:
-            if r["baseline"]:
-                cells = [r["label"], "—", "—"]
-                cells += [
-                    "nan" if r["success"].get(sp) is None else f"{r['success'][sp]:.2f}"
-                    for sp in splits
-                ]
-                cells.append(f"{r['normalized']:.2f}")
-                if nav:
-                    cells.append("—" if r["path_ratio"] is None else f"{r['path_ratio']:.2f}")
-            else:
-                wall = "—" if r["train_min"] is None else f"{r['train_min']:.1f} min"
-                cells = [r["label"], str(r["seeds"]), wall]
-                cells += [_fmt_cell(r["success"].get(sp)) for sp in splits]
-                cells.append(_fmt_cell(r["normalized"]))
-                if nav:
-                    pr = r["path_ratio"]
-                    cells.append("—" if pr is None else f"{pr:.2f} (median of seeds)")
-            lines.append("| " + " | ".join(cells) + " |")
-        out.append("\n".join(lines))
-    return "\n\n".join(out) + "\n"
+    return table.render(data)
 
 
-def report() -> str:
+def report(results: Path | None = None) -> str:
     """The markdown tables of the evaluated grid."""
-    return render(report_data())
+    return render(report_data(results))
+
+
+def _add_backend_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--backend",
+        choices=("local", "ray"),
+        default="local",
+        help="local: the cells one after the other in this process; ray: one Ray task per "
+        "cell (a local Ray instance, or the cluster at --address)",
+    )
+    p.add_argument(
+        "--address", default=None, help="an existing Ray cluster (e.g. auto, ray://head:10001)"
+    )
+    p.add_argument(
+        "--num-cpus", type=int, default=None, help="CPUs of a local Ray instance (default all)"
+    )
+    p.add_argument(
+        "--cpus-per-cell",
+        type=float,
+        default=1,
+        help="CPUs each Ray task reserves (training also uses that many torch threads)",
+    )
+    p.add_argument(
+        "--working-dir",
+        default=None,
+        help="ship this folder to the Ray workers (runtime_env working_dir), for a cluster "
+        "without this version installed",
+    )
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m benchmarks.reference", description=__doc__)
+    ap = argparse.ArgumentParser(
+        prog="python -m benchmarks.reference",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     sub = ap.add_subparsers(dest="cmd", required=True)
     t = sub.add_parser("train", help="train the grid (skips finished runs)")
     t.add_argument("--only", nargs="+", default=None, help="entries: NAME or NAME:Env-v0")
     t.add_argument("--seeds", nargs="+", type=int, default=list(SEEDS))
     t.add_argument("--print", action="store_true", help="print the commands, train nothing")
+    _add_backend_args(t)
     ev = sub.add_parser("evaluate", help="benchmark every trained model on every split")
     ev.add_argument("--episodes", type=int, default=100)
     ev.add_argument("--envs", nargs="+", default=None, help="only these env ids")
     ev.add_argument(
         "--only", nargs="+", default=None, help="only these entries' models (NAME or NAME:Env-v0)"
     )
-    ev.add_argument("--new", action="store_true", help="only models not evaluated yet")
-    rp = sub.add_parser("report", help="the markdown tables")
+    ev.add_argument("--seeds", nargs="+", type=int, default=None, help="only these training seeds")
+    ev.add_argument(
+        "--again", action="store_true", help="evaluate again the cells that have results"
+    )
+    ev.add_argument("--new", action="store_true", help="only cells without results (the default)")
+    ev.add_argument(
+        "--results",
+        type=Path,
+        default=RESULTS,
+        help=f"the per-run result files (default the tracked {RESULTS.relative_to(ROOT)})",
+    )
+    _add_backend_args(ev)
+    rp = sub.add_parser("report", help="the markdown tables, from the per-run result files")
+    rp.add_argument(
+        "--results",
+        type=Path,
+        default=RESULTS,
+        help=f"the per-run result files (default the tracked {RESULTS.relative_to(ROOT)})",
+    )
     _results.add_output_args(rp, "reference")
+    im = sub.add_parser(
+        "import",
+        help="per-run result files from the evaluations of earlier versions (runs/reference/)",
+    )
+    im.add_argument("old", type=Path, help="the runs/reference/ folder of an earlier version")
+    im.add_argument("--results", type=Path, default=RESULTS)
     args = ap.parse_args(argv)
+    if args.cmd == "import":
+        written = import_evaluations(args.old, args.results)
+        print(f"wrote {len(written)} result files under {args.results}")
+        return 0 if written else 1
     if args.cmd == "train":
         entries = _selected(args.only)
         if args.print:
@@ -552,13 +655,18 @@ def main(argv: list[str] | None = None) -> int:
                 for s in args.seeds:
                     print(e.command(s))
             return 0
-        train_grid(entries, args.seeds)
-    elif args.cmd == "evaluate":
-        found, evaluated = evaluate_grid(
+        done, trained, failed = train_grid(entries, args.seeds, **_backend(args))
+        print(f"{done} runs finished before, {trained} trained now, {len(failed)} failed")
+        return 1 if failed else 0
+    if args.cmd == "evaluate":
+        found, evaluated, failed = evaluate_grid(
             args.episodes,
             envs=args.envs,
             only=_selected(args.only) if args.only else None,
-            new=args.new,
+            seeds=args.seeds,
+            again=args.again,
+            results=args.results,
+            **_backend(args),
         )
         if not found:
             print(
@@ -566,23 +674,24 @@ def main(argv: list[str] | None = None) -> int:
                 f"{RUNS}/ (a run is finished when its final_model.zip exists); train them "
                 f"with: python -m benchmarks.reference train"
             )
-        elif not evaluated:
+            return 1
+        if not evaluated and not failed:
             print(
                 f"nothing new to evaluate: all {found} finished runs of the selected entries "
-                f"have results under {OUT}/ (without --new every model is evaluated again)"
+                f"have results under {args.results}/ (--again evaluates them again)"
             )
-    else:
-        data = {"command": _results.command("benchmarks.reference", argv), **report_data()}
-        if not data["envs"]:
-            print(
-                f"nothing to report: no benchmark results under {OUT}/; evaluate the trained "
-                f"models first with: python -m benchmarks.reference evaluate"
-                + (f" ({TRACKED} left as it is)" if args.update_results else ""),
-                file=sys.stderr,
-            )
-            return 1
-        print(render(data))
-        _results.write("reference", data, args.out, args.update_results)
+        return 1 if failed else 0
+    data = {"command": _results.command("benchmarks.reference", argv), **report_data(args.results)}
+    if not data["envs"]:
+        print(
+            f"nothing to report: no result files under {args.results}/; evaluate the trained "
+            f"models first with: python -m benchmarks.reference evaluate"
+            + (" (the tracked results left as they are)" if args.update_results else ""),
+            file=sys.stderr,
+        )
+        return 1
+    print(render(data))
+    _results.write("reference", data, args.out, args.update_results)
     return 0
 
 

@@ -2,8 +2,8 @@
 
     python -m benchmarks.watch_oracle [--episodes 200] [--seed 0]
 
-``evaluate_watch`` (``python -m agents.evaluation.watch``) of the oracle and of uniform random
-actions on ``corridor``, ``edr``, ``lab`` and ``warehouse`` with 1 and 2 watchers, the same episode
+:func:`agents.evaluation.watch.evaluate_watch` of the oracle and of uniform random actions
+on ``corridor``, ``edr``, ``lab`` and ``warehouse`` with 1 and 2 watchers, the same episode
 seeds (1,000,000 + seed onwards) for every row; complete model, 16 beams, watchers starting at
 seeded random free poses.  The data (``watch_oracle.json``, without the per-episode lists) and
 the page fragment go to ``--out`` (default ``runs/benchmarks/watch_oracle/``), or with
@@ -18,11 +18,7 @@ import time
 from typing import Any
 
 from agents.evaluation.evaluate import EVAL_SEED_BASE
-
-try:  # the watch evaluation's home in the layered package (agents.evaluation.watch)
-    from agents.evaluation.watch import evaluate_watch
-except ModuleNotFoundError:  # before it moved there
-    from agents.planning.watch_oracle import evaluate_watch
+from agents.evaluation.watch import evaluate_watch
 from sensorplan_gym.core.world import BUNDLED_SCENES
 
 from . import _results

@@ -95,9 +95,10 @@ def test_reference_report_with_nothing_to_do_says_so(tmp_path, monkeypatch, caps
     from benchmarks import reference
 
     monkeypatch.chdir(tmp_path)
-    assert reference.main(["report", "--update-results"]) == 1
-    err = capsys.readouterr().err
-    assert "nothing to report" in err and "left as it is" in err
+    assert reference.main(["evaluate", "--results", "res"]) == 1
+    assert "nothing to evaluate" in capsys.readouterr().out
+    assert reference.main(["report", "--results", "res"]) == 1
+    assert "nothing to report" in capsys.readouterr().err
     assert not (tmp_path / "runs" / "benchmarks").exists()
     assert (ROOT / "docs" / "results" / "reference.md").read_text(encoding="utf-8") == (
         _results.render("reference", _results.load("reference"))

@@ -190,32 +190,37 @@ def test_watch_json_must_be_writable(blocked, capsys):
 
 def test_reference_evaluate_and_report_say_when_there_is_nothing(tmp_path, monkeypatch, capsys):
     pytest.importorskip("yaml")
-    from benchmarks import reference
+    from benchmarks import _results, reference
 
     monkeypatch.chdir(tmp_path)  # RUNS = runs/ relative to the working folder: empty here
-    tracked = tmp_path / "tracked.md"
+    monkeypatch.setattr(_results, "FRAGMENT_DIR", tmp_path)
+    monkeypatch.setattr(_results, "DATA_DIR", tmp_path)
+    tracked = tmp_path / "reference.md"
     tracked.write_text("the tracked table\n")
-    monkeypatch.setattr(reference, "TRACKED", tracked)
-    assert reference.main(["evaluate", "--episodes", "1"]) == 0
+    assert reference.main(["evaluate", "--episodes", "1", "--results", "res"]) == 1
     assert "nothing to evaluate: no finished run" in capsys.readouterr().out
-    assert reference.main(["report", "--update-results"]) == 1
+    assert reference.main(["report", "--results", "res", "--update-results"]) == 1
     err = capsys.readouterr().err
-    assert "nothing to report" in err and "left as it is" in err
+    assert "nothing to report" in err and "left as they are" in err
     assert tracked.read_text() == "the tracked table\n"  # not overwritten by an empty table
-    assert not (tmp_path / "runs").exists()
+    assert not (tmp_path / "runs").exists() and not (tmp_path / "res").exists()
 
 
 def test_reference_evaluate_new_says_when_everything_has_results(tmp_path, monkeypatch, capsys):
     pytest.importorskip("yaml")
     from benchmarks import reference
+    from benchmarks.reference_table import run_file
 
     monkeypatch.chdir(tmp_path)
     e = next(e for e in reference.GRID if e.env_id == reference.PLACE and not e.discrete)
     for f in ("best_model.zip", "final_model.zip"):
         (e.out(0)).mkdir(parents=True, exist_ok=True)
         (e.out(0) / f).write_text("")
-    monkeypatch.setattr(
-        reference, "_evaluated", lambda env_id, discrete: {str(e.out(0) / "best_model.zip")}
-    )
-    assert reference.main(["evaluate", "--new", "--envs", reference.PLACE]) == 0
+    res = tmp_path / "res"
+    run_file(res, e.env_id, e.key, 0).parent.mkdir(parents=True)
+    run_file(res, e.env_id, e.key, 0).write_text("{}")
+    for name in ("oracle", "random"):  # evaluated baselines (a result per split)
+        (res / "Placement-v0" / f"{name}.json").write_text('{"splits": {}}')
+    argv = ["evaluate", "--envs", reference.PLACE, "--only", e.key, "--results", str(res)]
+    assert reference.main(argv) == 0
     assert "nothing new to evaluate: all 1 finished runs" in capsys.readouterr().out
