@@ -26,8 +26,9 @@ import shapely
 
 import sensorplan_gym  # noqa: F401
 from sensorplan_gym.core import fused
+from sensorplan_gym.core.cache import get_world
 from sensorplan_gym.core.segments import boundary_segments
-from sensorplan_gym.core.world import BUNDLED_SCENES, WorldConfig, get_world, load_scene
+from sensorplan_gym.core.world import BUNDLED_SCENES, WorldConfig, load_scene
 
 needs_numba = pytest.mark.skipif(not fused.FUSED, reason="numba not installed (the 'fast' extra)")
 NOISY = {"noise": 0.05, "eps_pos": 0.05, "eps_aim": 0.02}
