@@ -171,6 +171,7 @@ class _Driver:
         self.decision = None
         self.latched = 0.0  # a declaration, repeated until the env takes it (declare_hold)
         self.looks: list[float] | None = None
+        self.episode = -1  # the env's episode counter when this driver was made
 
     # -- planning -----------------------------------------------------------------------
     def _replan(self) -> None:
@@ -301,13 +302,75 @@ class _Driver:
         return 0.0
 
 
+class _SubEnv:
+    """Sub-environment ``i`` of a batched env (``SensorPlanVectorEnv``) seen through the
+    attributes the oracle reads from a single env (``world``, ``pose``, ``scan``, ...)."""
+
+    def __init__(self, batch, i: int) -> None:
+        self.batch = batch
+        self.i = int(i)
+        self.spec = None
+        self.max_turn = batch.max_turn
+        self.speed_limit = getattr(batch, "speed_limit", "box")
+        self.max_steps = batch.max_steps
+
+    @property
+    def unwrapped(self) -> _SubEnv:
+        return self
+
+    @property
+    def world(self):
+        return self.batch.worlds[self.i]
+
+    @property
+    def pose(self) -> tuple[float, float, float] | None:
+        return self.batch.pose(self.i) if self.batch.episodes[self.i] > 0 else None
+
+    @property
+    def scan(self):
+        return self.batch.scan(self.i) if self.batch.episodes[self.i] > 0 else None
+
+    @property
+    def start(self) -> tuple[float, float, float]:
+        return tuple(float(v) for v in self.batch.starts[self.i])
+
+    @property
+    def sensor(self):
+        return self.batch.sensor(self.i)
+
+    @property
+    def max_speed(self) -> float:
+        return float(self.batch.max_speed[self.i])
+
+    @property
+    def elapsed(self) -> int:
+        return int(self.batch.elapsed[self.i])
+
+
+_KINDS = {"Placement": "placement", "Navigate": "navigate", "Recognize": "recognize"}
+
+
+def _kind(batch) -> str:
+    name = type(batch).__name__.replace("Batch", "")
+    if name not in _KINDS:
+        raise TypeError(f"OraclePolicy supports the sensorplan envs, got a {type(batch).__name__}")
+    return _KINDS[name]
+
+
 class OraclePolicy:
     """Privileged planner with an SB3-style ``predict``.
 
     Parameters
     ----------
-    env : a Gymnasium env of this package (wrappers are looked through) or an SB3
-        ``DummyVecEnv`` of them.  ``SubprocVecEnv`` cannot be read from and is rejected.
+    env : a Gymnasium env of this package (wrappers are looked through), an SB3
+        ``DummyVecEnv`` of them, a native vector env (``gym.make_vec``,
+        :class:`sensorplan_gym.envs.vector.SensorPlanVectorEnv`) or the SB3
+        :class:`agents.vecenv.BatchedVecEnv` over one.  ``SubprocVecEnv`` cannot be read from
+        and is rejected.
+
+    The policy tells a new episode from the next step of the current one by itself: each
+    sub-environment counts the episodes it started (``batch.episodes``), so ``predict`` in a
+    plain loop (no ``episode_start``) never carries a plan into the next episode.
     """
 
     def __init__(self, env) -> None:
@@ -316,22 +379,36 @@ class OraclePolicy:
             raise TypeError(
                 "OraclePolicy needs in-process envs: use DummyVecEnv, not SubprocVecEnv"
             )
-        self.vectorized = envs is not None
-        self.envs = [e.unwrapped for e in (envs if envs is not None else [env])]
+        inner = getattr(env, "venv", None)  # agents.vecenv.BatchedVecEnv
+        vec = inner if inner is not None and hasattr(inner, "batch") else env
+        vec = getattr(vec, "unwrapped", vec)
+        if envs is None and hasattr(vec, "batch") and hasattr(vec, "num_envs"):
+            batch = vec.batch  # a native vector env: one view per sub-environment
+            self.vectorized = True
+            self.envs = [_SubEnv(batch, i) for i in range(batch.n)]
+        else:
+            self.vectorized = envs is not None
+            self.envs = [e.unwrapped for e in (envs if envs is not None else [env])]
         for e in self.envs:
-            kind = type(e).__name__
-            if kind not in ("PlacementEnv", "NavigateEnv", "RecognizeEnv"):
-                raise TypeError(f"OraclePolicy supports the sensorplan envs, got {kind}")
-            if getattr(e.batch, "action_type", "continuous") != "continuous":
+            batch = getattr(e, "batch", None)
+            if batch is None:
+                raise TypeError(f"OraclePolicy supports the sensorplan envs, got {type(e).__name__}")
+            e.spec_kind = _kind(batch)
+            if getattr(batch, "action_type", "continuous") != "continuous":
                 raise TypeError(
                     "OraclePolicy acts in the continuous action space; make the env with "
                     "action_type='continuous' (the default)"
                 )
-            e.spec_kind = kind.replace("Env", "").lower()
         self.drivers = [_Driver(e) for e in self.envs]
 
+    @staticmethod
+    def _episode(env) -> int:
+        """The number of episodes ``env`` (a single env or a :class:`_SubEnv`) has started."""
+        i = env.i if isinstance(env, _SubEnv) else 0
+        return int(env.batch.episodes[i])
+
     def reset(self) -> None:
-        """Forget all episode state (called automatically at episode starts)."""
+        """Forget all episode state (not needed between episodes: ``predict`` notices them)."""
         self.drivers = [_Driver(e) for e in self.envs]
 
     def predict(
@@ -341,7 +418,11 @@ class OraclePolicy:
         episode_start: Any = None,
         deterministic: bool = True,
     ) -> tuple[np.ndarray, Any]:
-        """Actions for the current state of the bound env(s); ``(actions, state)`` as in SB3."""
+        """Actions for the current state of the bound env(s); ``(actions, state)`` as in SB3.
+
+        ``observation`` is not read (the oracle reads the env); ``episode_start`` may be
+        given, as SB3 does, but is not needed.  Raises ``RuntimeError`` when an env has not
+        been reset yet."""
         starts = (
             np.zeros(len(self.envs), dtype=bool)
             if episode_start is None
@@ -349,18 +430,17 @@ class OraclePolicy:
         )
         actions = []
         for i, env in enumerate(self.envs):
+            ep = self._episode(env)
+            if ep == 0:
+                raise RuntimeError(
+                    f"OraclePolicy.predict: sub-environment {i} has not been reset; "
+                    "call env.reset() first"
+                )
             drv = self.drivers[i]
             new = bool(starts[i]) if i < len(starts) else False
-            if (
-                not new
-                and env.spec_kind != "placement"
-                and drv.steps > 0
-                and env.pose is not None
-                and np.allclose(env.pose, env.start, atol=0)
-            ):
-                new = True  # the env was reset behind our back
-            if new:
+            if new or drv.episode != ep:
                 drv = self.drivers[i] = _Driver(env)
+                drv.episode = ep
             actions.append(self._act(env, drv))
             drv.steps += 1
         out = np.stack(actions)
@@ -378,7 +458,7 @@ class OraclePolicy:
         # Recognize: look once there, sweep the fan of beams, then decide
         decide = 0.0
         horizon = env.max_steps or (env.spec.max_episode_steps if env.spec else None) or 200
-        final = drv.steps >= horizon - 1
+        final = env.elapsed >= horizon - 1
         drv.looking = drv.looking or drv.arrived
         if drv.latched:
             decide = drv.latched

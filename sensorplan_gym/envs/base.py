@@ -255,6 +255,9 @@ class SensorPlanBatch(BatchSim):
         self.action_type = action_type
         self.single_action_space = self.actions.space
         self.elapsed = np.zeros(self.n, dtype=np.int64)
+        # episodes started per sub-environment: a planner bound to the env tells a new
+        # episode from the next step of the current one by it (agents.oracle)
+        self.episodes = np.zeros(self.n, dtype=np.int64)
         self.random = isinstance(scene, str) and scene == "random"
         if not isinstance(min_start_distance, (int, float)) or not 0 <= min_start_distance < 1:
             raise ValueError(f"min_start_distance must be in [0, 1), got {min_start_distance!r}")
@@ -300,6 +303,7 @@ class SensorPlanBatch(BatchSim):
             self.load_world(i, world)
             self.starts[i] = start
             self.elapsed[i] = 0
+            self.episodes[i] += 1
             self._reset_one(i, options)
         self._after_reset(idx)
 

@@ -100,13 +100,19 @@ class RecognizeBatch(RobotBatch):
         # of the hull of every placement (the must-see hull), else re-draw up to 20 times
         xy = (self.x[i], self.y[i])
         far = k["hulls"][side - 1].distance(shapely.Point(xy)) > w.robot_radius + 1e-9
+        clear = far
         for _ in range(20):
             q = w.sample_in(which, rng)
             th = rng.uniform(0.0, 2 * math.pi) if w.theta is None else 0.0
             c, s = math.cos(th), math.sin(th)
             poly = w.target @ np.array([[c, s], [-s, c]]) + q
-            if far or shapely.Polygon(poly).distance(shapely.Point(xy)) > w.robot_radius + 1e-9:
+            clear = far or shapely.Polygon(poly).distance(shapely.Point(xy)) > w.robot_radius + 1e-9
+            if clear:
                 break
+        if not clear:
+            # the robot would stand in the target (G or H is a point whose target covers the
+            # start, or every draw met it): start elsewhere rather than inside a solid object
+            self._start_clear_of(i, shapely.Polygon(poly))
         self.side[i] = side
         self.target_polys[i] = poly
         if w.theta is None:
@@ -118,6 +124,30 @@ class RecognizeBatch(RobotBatch):
             rows[1] += q[1]
         self.tsegs.set_row(i, rows)
         self.set_segments(i, np.concatenate([k["static"], rows], axis=1))
+
+    def _start_clear_of(self, i: int, target: shapely.Polygon) -> None:
+        """Move sub-environment ``i``'s robot to a start drawn from its generator as
+        ``random_start`` draws one (free, outside the region, in a part of the free space
+        that reaches it), that also keeps the robot disc clear of ``target``.  Raises
+        ``RuntimeError`` when 10,000 draws find none."""
+        w = self.worlds[i]
+        rng = self.rngs[i]
+        comps = shapely.get_parts(w.robot_space)
+        space = shapely.union_all(comps[shapely.intersects(comps, w.region)])
+        keep = target.buffer(w.robot_radius + 1e-6 * w.diameter)
+        for _ in range(10_000):
+            x = float(rng.uniform(w.lo[0], w.hi[0]))
+            y = float(rng.uniform(w.lo[1], w.hi[1]))
+            if (
+                shapely.contains_xy(space, x, y)
+                and not w.in_region(x, y)
+                and not shapely.contains_xy(keep, x, y)
+            ):
+                self.set_pose(i, (x, y, float(rng.uniform(-math.pi, math.pi))))
+                return
+        raise RuntimeError(
+            f"scene {w.scene.name!r}: no start outside the region keeps clear of the target"
+        )
 
     def _reset_one(self, i: int, options: dict) -> None:
         self._start_from_options(i, {})
