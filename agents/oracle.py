@@ -172,6 +172,7 @@ class _Driver:
         self.latched = 0.0  # a declaration, repeated until the env takes it (declare_hold)
         self.looks: list[float] | None = None
         self.episode = -1  # the env's episode counter when this driver was made
+        self.expect: np.ndarray | None = None  # where the last action should take the robot
 
     # -- planning -----------------------------------------------------------------------
     def _replan(self) -> None:
@@ -179,9 +180,12 @@ class _Driver:
         x, y, _ = self.env.pose
         keep_out = None
         if self.env.spec_kind == "recognize":
-            keep_out = shapely.union(
-                *(shapely.convex_hull(shapely.multipoints(k)) for k in w.must_see)
-            )
+            # where the hidden target may stand: CH(A (+) G) and CH(A (+) H), less a hull the
+            # robot is in already (it cannot keep out of that one)
+            here = shapely.Point(x, y)
+            hulls = [shapely.convex_hull(shapely.multipoints(k)) for k in w.must_see]
+            hulls = [h for h in hulls if not h.intersects(here)]
+            keep_out = shapely.union_all(hulls) if hulls else None
         self.plan = plan_viewpoint(w, (x, y), keep_out=keep_out)
         self.looks = None
         if self.plan.status != "ok" and self.env.spec_kind == "recognize":
@@ -201,6 +205,14 @@ class _Driver:
         pos = np.array([x, y])
         if self.plan is None:
             self._replan()
+        elif self.expect is not None and (
+            abs(pos[0] - self.expect[0]) + abs(pos[1] - self.expect[1]) > 1e-6 * env.world.diameter
+        ):
+            # not where the last action of the plan led: a collision, or another policy
+            # drove (DAgger labels the states a learner visits): plan from here
+            self._replan()
+            self.looking = False
+            self.stuck = 0
         if (
             self.last_xy is not None
             and self.waypoints
@@ -239,6 +251,7 @@ class _Driver:
             aim = min(
                 (travel - math.pi / 4, travel + math.pi / 4), key=lambda a: abs(_wrap(a - psi))
             )
+        self.expect = pos + move
         c, s = math.cos(psi), math.sin(psi)
         fwd = (c * move[0] + s * move[1]) / v
         lat = (-s * move[0] + c * move[1]) / v
