@@ -405,7 +405,9 @@ class OraclePolicy:
         for e in self.envs:
             batch = getattr(e, "batch", None)
             if batch is None:
-                raise TypeError(f"OraclePolicy supports the sensorplan envs, got {type(e).__name__}")
+                raise TypeError(
+                    f"OraclePolicy supports the sensorplan envs, got {type(e).__name__}"
+                )
             e.spec_kind = _kind(batch)
             if getattr(batch, "action_type", "continuous") != "continuous":
                 raise TypeError(
