@@ -124,9 +124,13 @@ def plan_viewpoint(
     clearance = max(rr, min(rr + 1e-4 * world.diameter, rr + 0.25 * (room - rr)))
 
     def attempt(reg: shapely.Geometry) -> ViewpointPlan:
-        pl = choose_placement(
-            world.scene, reg, start, robot_radius=clearance, margin=margin, keep_out=keep_out
-        )
+        # a region thinner than twice the margin vanishes when shrunk: then smaller margins
+        for m in (margin, margin / 10, margin / 100):
+            pl = choose_placement(
+                world.scene, reg, start, robot_radius=clearance, margin=m, keep_out=keep_out
+            )
+            if pl.status == "ok":
+                break
         if pl.status != "ok":
             return ViewpointPlan(pl.status, reason=pl.reason, placement=pl)
         psi, _ = _aim_for(world, pl.point)
@@ -148,6 +152,47 @@ def plan_viewpoint(
     if plan.status == "ok" and not world.aim_ok(*plan.point, plan.aim):
         plan.status, plan.reason = "no_placement", "the chosen point fails the aim check"
     return plan
+
+
+def _swept_hulls(world) -> list[shapely.Geometry]:
+    """CH(A (+) G) and CH(A (+) H): the hulls of the target swept over G and over H."""
+    k = world._cache.get("oracle_hulls")
+    if k is None:
+        k = world._cache["oracle_hulls"] = [
+            shapely.convex_hull(shapely.multipoints(h)) for h in world.must_see
+        ]
+    return k
+
+
+def _convex_parts(g: shapely.Geometry) -> list[np.ndarray]:
+    """Vertex arrays of convex pieces whose union is ``g`` (a point, or the triangles of a
+    constrained Delaunay triangulation of a polygon)."""
+    if g.geom_type == "Point":
+        return [np.array([[g.x, g.y]])]
+    tris = shapely.get_parts(shapely.constrained_delaunay_triangles(g))
+    return [np.asarray(t.exterior.coords)[:-1] for t in tris]
+
+
+def _footprints(world) -> list[shapely.Geometry]:
+    """The exact A (+) G and A (+) H: every point the target covers at some placement in G,
+    resp. H (for a rotating target, G and H grown by the target's radius).  A Minkowski sum of
+    convex pieces is the hull of their vertex sums."""
+    k = world._cache.get("oracle_footprints")
+    if k is not None:
+        return k
+    out = []
+    for g in (world.goal_geom, world.failure_geom):
+        if world.theta is None:
+            out.append(g.buffer(world.target_radius))
+            continue
+        pieces = [
+            shapely.convex_hull(shapely.multipoints((a[:, None, :] + b[None, :, :]).reshape(-1, 2)))
+            for a in _convex_parts(shapely.Polygon(world.target))
+            for b in _convex_parts(g)
+        ]
+        out.append(shapely.union_all(pieces))
+    world._cache["oracle_footprints"] = out
+    return out
 
 
 def _wrap(a: float) -> float:
@@ -173,29 +218,66 @@ class _Driver:
         self.looks: list[float] | None = None
         self.episode = -1  # the env's episode counter when this driver was made
         self.expect: np.ndarray | None = None  # where the last action should take the robot
+        self.last_move: np.ndarray | None = None
+        self.bumps: list[shapely.Geometry] = []  # discs where the robot ran into the target
 
     # -- planning -----------------------------------------------------------------------
+    def _keep_outs(self) -> list[shapely.Geometry | None]:
+        """Areas to keep out of, most cautious first (Recognize; ``[None]`` otherwise): where
+        the hidden target may stand, CH(A (+) G) and CH(A (+) H), less a hull the robot is in
+        already (it cannot keep out of that one), then the exact A (+) G and A (+) H less one
+        the robot is in, each with what the robot bumped into off the map; then the bumps
+        alone; then nothing."""
+        if self.env.spec_kind != "recognize":
+            return [None]
+        w = self.env.world
+        x, y, _ = self.env.pose
+        here = shapely.Point(x, y)
+        bumped = shapely.union_all(self.bumps) if self.bumps else None
+        out: list[shapely.Geometry | None] = []
+        families = [_swept_hulls(w)] + ([_footprints(w)] if self.bumps else [])
+        for family in families:
+            parts = [g for g in family if not g.intersects(here)]
+            if bumped is not None:
+                parts.append(bumped)
+            if parts:
+                out.append(shapely.union_all(parts))
+        if bumped is not None:
+            out.append(bumped)
+        out.append(None)
+        return out
+
     def _replan(self) -> None:
         w = self.env.world
         x, y, _ = self.env.pose
-        keep_out = None
-        if self.env.spec_kind == "recognize":
-            # where the hidden target may stand: CH(A (+) G) and CH(A (+) H), less a hull the
-            # robot is in already (it cannot keep out of that one)
-            here = shapely.Point(x, y)
-            hulls = [shapely.convex_hull(shapely.multipoints(k)) for k in w.must_see]
-            hulls = [h for h in hulls if not h.intersects(here)]
-            keep_out = shapely.union_all(hulls) if hulls else None
-        self.plan = plan_viewpoint(w, (x, y), keep_out=keep_out)
-        self.looks = None
-        if self.plan.status != "ok" and self.env.spec_kind == "recognize":
-            # no single aim sees both: stand anywhere in the region, look at G, then at H
-            self.plan = plan_viewpoint(w, (x, y), keep_out=keep_out, joint_aim=False)
+        for keep_out in self._keep_outs():
+            self.plan = plan_viewpoint(w, (x, y), keep_out=keep_out)
+            self.looks = None
+            if self.plan.status != "ok" and self.env.spec_kind == "recognize":
+                # no single aim sees both: stand anywhere in the region, look at G, then at H
+                self.plan = plan_viewpoint(w, (x, y), keep_out=keep_out, joint_aim=False)
+                if self.plan.status == "ok":
+                    p = self.plan.point
+                    self.looks = [best_aim(p, k, w.fov, w.eps_aim)[0] for k in w.must_see]
+                    self.plan.aim = self.looks[0]
             if self.plan.status == "ok":
-                p = self.plan.point
-                self.looks = [best_aim(p, k, w.fov, w.eps_aim)[0] for k in w.must_see]
-                self.plan.aim = self.looks[0]
+                break
         self.waypoints = [] if self.plan.status != "ok" else [p for p in self.plan.path[1:]]
+
+    def _bumped(self, pos: np.ndarray) -> None:
+        """After a collision away from the map's walls and obstacles (Recognize: the hidden
+        target), remember a small disc just ahead of the contact as an obstacle."""
+        env = self.env
+        if env.spec_kind != "recognize" or not env.collided or self.last_move is None:
+            return
+        w = env.world
+        n = float(np.hypot(*self.last_move))
+        gap = float(w.free_space.boundary.distance(shapely.Point(pos)))
+        if n == 0 or gap <= 1e-3 * w.diameter + w.robot_radius:
+            return  # a wall or an obstacle of the map: the plan already knows it
+        r = 0.1 * w.target_radius
+        c = pos + self.last_move * ((r + w.robot_radius + 1e-4 * w.diameter) / n)
+        self.bumps.append(shapely.Point(c).buffer(r, quad_segs=4))
 
     # -- motion -------------------------------------------------------------------------
     def drive(self) -> np.ndarray:
@@ -210,6 +292,7 @@ class _Driver:
         ):
             # not where the last action of the plan led: a collision, or another policy
             # drove (DAgger labels the states a learner visits): plan from here
+            self._bumped(pos)
             self._replan()
             self.looking = False
             self.stuck = 0
@@ -252,6 +335,7 @@ class _Driver:
                 (travel - math.pi / 4, travel + math.pi / 4), key=lambda a: abs(_wrap(a - psi))
             )
         self.expect = pos + move
+        self.last_move = move
         c, s = math.cos(psi), math.sin(psi)
         fwd = (c * move[0] + s * move[1]) / v
         lat = (-s * move[0] + c * move[1]) / v

@@ -117,3 +117,30 @@ def test_robot_never_starts_inside_the_target_and_the_oracle_wins(bench_scenes, 
     # the scene's own start is where it was drawn: only this episode moved the robot
     assert target.contains(shapely.Point(u.start[:2]))
     assert plain_loop(env, OraclePolicy(env), [SEED0 + run])[0]["is_success"]
+
+
+def _family_scene(k: int) -> dict:
+    """Scene ``k`` of a 60-degree family with polygonal G and H (``random_scene`` seed 7)."""
+    rng = np.random.default_rng(7)
+    for _ in range(k + 1):
+        d = random_scene(rng, goal="polygon", fov_deg=60)
+    return d
+
+
+def test_oracle_goes_around_the_target_it_bumped_into():
+    # the robot starts inside CH(A (+) G), so that hull cannot be kept out of; the straight
+    # line to the region ran into the hidden target in G and the oracle pushed against it
+    # for 200 steps; now the bump is an obstacle and it plans around it
+    env = gym.make("sensorplan/Recognize-v0", scene=_family_scene(55), random_start=True)
+    pol = OraclePolicy(env)
+    info = plain_loop(env, pol, [551])[0]
+    assert info["is_success"]
+    assert pol.drivers[0].bumps, "the case no longer bumps: pick another"
+
+
+def test_oracle_reaches_a_recognizable_region_thinner_than_its_margin():
+    # the region is a sliver of area 1e-3: shrunk by the safety margin it vanished, and the
+    # oracle stood still until the timeout
+    env = gym.make("sensorplan/Recognize-v0", scene=_family_scene(19), random_start=True)
+    assert env.unwrapped.world.region.area < 2e-3
+    assert plain_loop(env, OraclePolicy(env), [190])[0]["is_success"]
