@@ -476,8 +476,9 @@ class OraclePolicy:
             raise TypeError(
                 "OraclePolicy needs in-process envs: use DummyVecEnv, not SubprocVecEnv"
             )
-        inner = getattr(env, "venv", None)  # agents.vecenv.BatchedVecEnv
-        vec = inner if inner is not None and hasattr(inner, "batch") else env
+        vec = env
+        while envs is None and not hasattr(vec, "batch") and hasattr(vec, "venv"):
+            vec = vec.venv  # SB3 wrappers (VecMonitor, ...) and agents.vecenv.BatchedVecEnv
         vec = getattr(vec, "unwrapped", vec)
         if envs is None and hasattr(vec, "batch") and hasattr(vec, "num_envs"):
             batch = vec.batch  # a native vector env: one view per sub-environment

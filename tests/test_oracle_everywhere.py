@@ -144,3 +144,17 @@ def test_oracle_reaches_a_recognizable_region_thinner_than_its_margin():
     env = gym.make("sensorplan/Recognize-v0", scene=_family_scene(19), random_start=True)
     assert env.unwrapped.world.region.area < 2e-3
     assert plain_loop(env, OraclePolicy(env), [190])[0]["is_success"]
+
+
+def test_oracle_reads_through_sb3_wrappers_of_the_batched_env():
+    pytest.importorskip("stable_baselines3")
+    from stable_baselines3.common.evaluation import evaluate_policy
+    from stable_baselines3.common.vec_env import VecMonitor
+
+    from agents.vecenv import make_batched_vec_env
+
+    venv = VecMonitor(make_batched_vec_env("sensorplan/Navigate-v0", 3, seed=2))
+    pol = OraclePolicy(venv)
+    assert len(pol.envs) == 3
+    mean, _ = evaluate_policy(pol, venv, n_eval_episodes=6)
+    assert mean > 0.8
