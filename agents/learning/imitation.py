@@ -52,6 +52,7 @@ from stable_baselines3.common.policies import ActorCriticPolicy, BasePolicy
 import sensorplan_gym  # noqa: F401  (registers the env ids)
 from agents.oracle import OraclePolicy
 from agents.policies import algo_class
+from agents.train import _activation
 from agents.vecenv import BatchedVecEnv
 
 __all__ = [
@@ -367,8 +368,6 @@ class _WallClock(BaseCallback):
 
 
 def _model(cfg: dict, venv_sb3, seed: int):
-    from agents.train import _activation
-
     kw = dict(cfg.get("ppo") or {})
     pk = dict(cfg.get("policy_kwargs") or {})
     if "activation_fn" in pk:
