@@ -443,6 +443,10 @@ class _SubEnv:
     def elapsed(self) -> int:
         return int(self.batch.elapsed[self.i])
 
+    @property
+    def collided(self) -> bool:
+        return bool(self.batch.collided[self.i])
+
 
 _KINDS = {"Placement": "placement", "Navigate": "navigate", "Recognize": "recognize"}
 

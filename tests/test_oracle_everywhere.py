@@ -158,3 +158,16 @@ def test_oracle_reads_through_sb3_wrappers_of_the_batched_env():
     assert len(pol.envs) == 3
     mean, _ = evaluate_policy(pol, venv, n_eval_episodes=6)
     assert mean > 0.8
+
+
+def test_bump_handling_on_a_native_vector_env():
+    venv = gym.make_vec(
+        "sensorplan/Recognize-v0", num_envs=1, scene=_family_scene(55), random_start=True
+    )
+    pol = OraclePolicy(venv)
+    obs, _ = venv.reset(seed=551)
+    for _ in range(200):
+        obs, _, term, trunc, info = venv.step(pol.predict(obs)[0])
+        if term[0] or trunc[0]:
+            break
+    assert pol.drivers[0].bumps and info["is_success"][0]
