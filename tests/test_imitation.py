@@ -42,7 +42,7 @@ def _ppo(venv, net=(64, 64)) -> PPO:
 
 
 def test_dagger_on_a_tiny_pool_reaches_the_oracle_quickly():
-    t0 = time.perf_counter()
+    t0 = time.process_time()  # CPU time: what the machine's other load does not change
     venv = gym.make_vec(NAV, num_envs=8, **TINY)
     model = _ppo(venv)
     before = success_rate(model.policy, NAV, TINY, 32, n_envs=8)
@@ -55,7 +55,7 @@ def test_dagger_on_a_tiny_pool_reaches_the_oracle_quickly():
     assert before < 1.0  # the untrained policy does not (the test can fail)
     assert [h["beta"] for h in res.history] == [0.5**i for i in range(6)]
     assert res.history[-1]["expert_fraction"] < 0.2
-    assert time.perf_counter() - t0 < 45
+    assert time.process_time() - t0 < 45  # about 10 s of CPU measured
 
 
 def test_collect_records_oracle_labels_of_the_states_the_learner_visits():
