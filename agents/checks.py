@@ -29,6 +29,8 @@ EXTRA_OF_MODULE = {
     "pettingzoo": "multi",
     "ray": "multi",
     "bokeh": "viewer",
+    "minari": "imitation",
+    "h5py": "imitation",
 }
 
 

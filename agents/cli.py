@@ -11,6 +11,10 @@
     sensorplan convert plan.geojson scene.json   (GeoJSON / WKT / scene JSON, by extension,
                                                   or a bundled name as input: convert lab
                                                   lab.geojson; see geometry.formats)
+    sensorplan dataset record --env ID --episodes N --dataset-id ns/name-v0   (oracle demos,
+                                Minari; see agents.learning.dataset)
+    sensorplan imitate --env ID --method bc|dagger|dagger+ppo   (learning from the oracle;
+                                see agents.learning.imitation)
     sensorplan view lab        (scenes and exact regions in the browser; --export view.html
                                 writes one self-contained file; see sensorplan_gym.viewer)
     sensorplan record --policy oracle --out ep.json   (one episode for sensorplan view
@@ -48,7 +52,8 @@ def build_parser() -> argparse.ArgumentParser:
         description="Sensor planning (Briggs & Donald): train and evaluate agents, run the demo.",
     )
     sub = parser.add_subparsers(
-        dest="command", metavar="{train,evaluate,benchmark,demo,convert,view,record}"
+        dest="command",
+        metavar="{train,evaluate,benchmark,demo,convert,view,record,dataset,imitate}",
     )
     sub.required = True
 
@@ -257,6 +262,52 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--max-steps", type=int, default=None)
     r.add_argument("--env-kwargs", type=_json_dict, default=None, help="JSON gym.make kwargs")
     r.add_argument("--out", default="rollout.json", help="rollout file (default rollout.json)")
+
+    d = sub.add_parser(
+        "dataset",
+        help="record oracle demonstrations as a Minari dataset (agents/learning/dataset.py)",
+    )
+    dsub = d.add_subparsers(dest="dataset_command", metavar="{record}")
+    dsub.required = True
+    dr = dsub.add_parser(
+        "record",
+        help="play the oracle and write a Minari dataset (minari.load_dataset loads it)",
+    )
+    dr.add_argument("--env", required=True, help=ENV_CHOICES_HELP)
+    dr.add_argument("--episodes", type=int, required=True)
+    dr.add_argument(
+        "--dataset-id", required=True, help="Minari id 'namespace/name-v0', e.g. sensorplan/lab-v0"
+    )
+    dr.add_argument("--seed", type=int, default=0, help="episode k is reset with seed + k")
+    dr.add_argument("--env-kwargs", type=_json_dict, default=None, help="JSON gym.make kwargs")
+    dr.add_argument(
+        "--data-path", default=None, help="dataset folder (default: Minari's, ~/.minari/datasets)"
+    )
+    dr.add_argument("--overwrite", action="store_true", help="replace a dataset of that id")
+
+    im = sub.add_parser(
+        "imitate",
+        help="learn from the oracle: bc, dagger, dagger+ppo (or ppo from scratch)",
+        description="Behaviour cloning / DAgger on the batched env with the oracle as the "
+        "expert, optionally followed by PPO fine-tuning; hyperparameters from "
+        "agents/configs/imitation.yaml (see agents/learning/imitation.py).",
+    )
+    im.add_argument("--env", required=True, help=ENV_CHOICES_HELP)
+    im.add_argument("--method", default="dagger", choices=("bc", "dagger", "dagger+ppo", "ppo"))
+    im.add_argument("--seed", type=int, default=0)
+    im.add_argument("--config", default=None, help="YAML (default agents/configs/imitation.yaml)")
+    im.add_argument(
+        "--out", default=None, help="output folder (default runs/<method>_<env>_s<seed>)"
+    )
+    im.add_argument(
+        "--wall-s", type=float, default=None, help="wall-clock budget in seconds for the run"
+    )
+    im.add_argument(
+        "--overrides",
+        type=_json_dict,
+        default=None,
+        help="JSON merged into the config section, e.g. '{\"n_envs\": 16}'",
+    )
     return parser
 
 
@@ -395,6 +446,34 @@ def main(argv: list[str] | None = None) -> int:
                     checkpoint_freq=args.checkpoint_freq,
                     resume=args.resume,
                 )
+            return 0
+        if args.command == "dataset":
+            from .learning.dataset import record_dataset
+
+            ds = record_dataset(
+                args.env,
+                args.dataset_id,
+                args.episodes,
+                env_kwargs=args.env_kwargs,
+                seed=args.seed,
+                data_path=args.data_path,
+                overwrite=args.overwrite,
+            )
+            print(f"{args.dataset_id}: {ds.total_episodes} episodes, {ds.total_steps} steps")
+            return 0
+        if args.command == "imitate":
+            from .learning.imitation import train_imitation
+
+            rec = train_imitation(
+                args.env,
+                args.method,
+                config=args.config,
+                seed=args.seed,
+                out=args.out,
+                wall_s=args.wall_s,
+                overrides=args.overrides,
+            )
+            print(f"model: {rec['out']}/final_model.zip  ({rec['wall_time_s']} s)")
             return 0
         if args.command == "benchmark":
             from .evaluation.benchmark import DEFAULT_DIFFICULTY, benchmark

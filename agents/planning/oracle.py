@@ -124,9 +124,13 @@ def plan_viewpoint(
     clearance = max(rr, min(rr + 1e-4 * world.diameter, rr + 0.25 * (room - rr)))
 
     def attempt(reg: shapely.Geometry) -> ViewpointPlan:
-        pl = choose_placement(
-            world.scene, reg, start, robot_radius=clearance, margin=margin, keep_out=keep_out
-        )
+        # a region thinner than twice the margin vanishes when shrunk: then smaller margins
+        for m in (margin, margin / 10, margin / 100):
+            pl = choose_placement(
+                world.scene, reg, start, robot_radius=clearance, margin=m, keep_out=keep_out
+            )
+            if pl.status == "ok":
+                break
         if pl.status != "ok":
             return ViewpointPlan(pl.status, reason=pl.reason, placement=pl)
         psi, _ = _aim_for(world, pl.point)
@@ -150,6 +154,47 @@ def plan_viewpoint(
     return plan
 
 
+def _swept_hulls(world) -> list[shapely.Geometry]:
+    """CH(A (+) G) and CH(A (+) H): the hulls of the target swept over G and over H."""
+    k = world._cache.get("oracle_hulls")
+    if k is None:
+        k = world._cache["oracle_hulls"] = [
+            shapely.convex_hull(shapely.multipoints(h)) for h in world.must_see
+        ]
+    return k
+
+
+def _convex_parts(g: shapely.Geometry) -> list[np.ndarray]:
+    """Vertex arrays of convex pieces whose union is ``g`` (a point, or the triangles of a
+    constrained Delaunay triangulation of a polygon)."""
+    if g.geom_type == "Point":
+        return [np.array([[g.x, g.y]])]
+    tris = shapely.get_parts(shapely.constrained_delaunay_triangles(g))
+    return [np.asarray(t.exterior.coords)[:-1] for t in tris]
+
+
+def _footprints(world) -> list[shapely.Geometry]:
+    """The exact A (+) G and A (+) H: every point the target covers at some placement in G,
+    resp. H (for a rotating target, G and H grown by the target's radius).  A Minkowski sum of
+    convex pieces is the hull of their vertex sums."""
+    k = world._cache.get("oracle_footprints")
+    if k is not None:
+        return k
+    out = []
+    for g in (world.goal_geom, world.failure_geom):
+        if world.theta is None:
+            out.append(g.buffer(world.target_radius))
+            continue
+        pieces = [
+            shapely.convex_hull(shapely.multipoints((a[:, None, :] + b[None, :, :]).reshape(-1, 2)))
+            for a in _convex_parts(shapely.Polygon(world.target))
+            for b in _convex_parts(g)
+        ]
+        out.append(shapely.union_all(pieces))
+    world._cache["oracle_footprints"] = out
+    return out
+
+
 def _wrap(a: float) -> float:
     return (a + math.pi) % (2 * math.pi) - math.pi
 
@@ -171,26 +216,68 @@ class _Driver:
         self.decision = None
         self.latched = 0.0  # a declaration, repeated until the env takes it (declare_hold)
         self.looks: list[float] | None = None
+        self.episode = -1  # the env's episode counter when this driver was made
+        self.expect: np.ndarray | None = None  # where the last action should take the robot
+        self.last_move: np.ndarray | None = None
+        self.bumps: list[shapely.Geometry] = []  # discs where the robot ran into the target
 
     # -- planning -----------------------------------------------------------------------
+    def _keep_outs(self) -> list[shapely.Geometry | None]:
+        """Areas to keep out of, most cautious first (Recognize; ``[None]`` otherwise): where
+        the hidden target may stand, CH(A (+) G) and CH(A (+) H), less a hull the robot is in
+        already (it cannot keep out of that one), then the exact A (+) G and A (+) H less one
+        the robot is in, each with what the robot bumped into off the map; then the bumps
+        alone; then nothing."""
+        if self.env.spec_kind != "recognize":
+            return [None]
+        w = self.env.world
+        x, y, _ = self.env.pose
+        here = shapely.Point(x, y)
+        bumped = shapely.union_all(self.bumps) if self.bumps else None
+        out: list[shapely.Geometry | None] = []
+        families = [_swept_hulls(w)] + ([_footprints(w)] if self.bumps else [])
+        for family in families:
+            parts = [g for g in family if not g.intersects(here)]
+            if bumped is not None:
+                parts.append(bumped)
+            if parts:
+                out.append(shapely.union_all(parts))
+        if bumped is not None:
+            out.append(bumped)
+        out.append(None)
+        return out
+
     def _replan(self) -> None:
         w = self.env.world
         x, y, _ = self.env.pose
-        keep_out = None
-        if self.env.spec_kind == "recognize":
-            keep_out = shapely.union(
-                *(shapely.convex_hull(shapely.multipoints(k)) for k in w.must_see)
-            )
-        self.plan = plan_viewpoint(w, (x, y), keep_out=keep_out)
-        self.looks = None
-        if self.plan.status != "ok" and self.env.spec_kind == "recognize":
-            # no single aim sees both: stand anywhere in the region, look at G, then at H
-            self.plan = plan_viewpoint(w, (x, y), keep_out=keep_out, joint_aim=False)
+        for keep_out in self._keep_outs():
+            self.plan = plan_viewpoint(w, (x, y), keep_out=keep_out)
+            self.looks = None
+            if self.plan.status != "ok" and self.env.spec_kind == "recognize":
+                # no single aim sees both: stand anywhere in the region, look at G, then at H
+                self.plan = plan_viewpoint(w, (x, y), keep_out=keep_out, joint_aim=False)
+                if self.plan.status == "ok":
+                    p = self.plan.point
+                    self.looks = [best_aim(p, k, w.fov, w.eps_aim)[0] for k in w.must_see]
+                    self.plan.aim = self.looks[0]
             if self.plan.status == "ok":
-                p = self.plan.point
-                self.looks = [best_aim(p, k, w.fov, w.eps_aim)[0] for k in w.must_see]
-                self.plan.aim = self.looks[0]
+                break
         self.waypoints = [] if self.plan.status != "ok" else [p for p in self.plan.path[1:]]
+
+    def _bumped(self, pos: np.ndarray) -> None:
+        """After a collision away from the map's walls and obstacles (Recognize: the hidden
+        target), remember a small disc just ahead of the contact as an obstacle."""
+        env = self.env
+        if env.spec_kind != "recognize" or not env.collided or self.last_move is None:
+            return
+        w = env.world
+        n = float(np.hypot(*self.last_move))
+        gap = float(w.free_space.boundary.distance(shapely.Point(pos)))
+        if n == 0 or gap <= 1e-3 * w.diameter + w.robot_radius:
+            return  # a wall or an obstacle of the map: the plan already knows it
+        r = 0.1 * w.target_radius
+        c = pos + self.last_move * ((r + w.robot_radius + 1e-4 * w.diameter) / n)
+        self.bumps.append(shapely.Point(c).buffer(r, quad_segs=4))
 
     # -- motion -------------------------------------------------------------------------
     def drive(self) -> np.ndarray:
@@ -200,6 +287,15 @@ class _Driver:
         pos = np.array([x, y])
         if self.plan is None:
             self._replan()
+        elif self.expect is not None and (
+            abs(pos[0] - self.expect[0]) + abs(pos[1] - self.expect[1]) > 1e-6 * env.world.diameter
+        ):
+            # not where the last action of the plan led: a collision, or another policy
+            # drove (DAgger labels the states a learner visits): plan from here
+            self._bumped(pos)
+            self._replan()
+            self.looking = False
+            self.stuck = 0
         if (
             self.last_xy is not None
             and self.waypoints
@@ -238,6 +334,8 @@ class _Driver:
             aim = min(
                 (travel - math.pi / 4, travel + math.pi / 4), key=lambda a: abs(_wrap(a - psi))
             )
+        self.expect = pos + move
+        self.last_move = move
         c, s = math.cos(psi), math.sin(psi)
         fwd = (c * move[0] + s * move[1]) / v
         lat = (-s * move[0] + c * move[1]) / v
@@ -301,13 +399,79 @@ class _Driver:
         return 0.0
 
 
+class _SubEnv:
+    """Sub-environment ``i`` of a batched env (``SensorPlanVectorEnv``) seen through the
+    attributes the oracle reads from a single env (``world``, ``pose``, ``scan``, ...)."""
+
+    def __init__(self, batch, i: int) -> None:
+        self.batch = batch
+        self.i = int(i)
+        self.spec = None
+        self.max_turn = batch.max_turn
+        self.speed_limit = getattr(batch, "speed_limit", "box")
+        self.max_steps = batch.max_steps
+
+    @property
+    def unwrapped(self) -> _SubEnv:
+        return self
+
+    @property
+    def world(self):
+        return self.batch.worlds[self.i]
+
+    @property
+    def pose(self) -> tuple[float, float, float] | None:
+        return self.batch.pose(self.i) if self.batch.episodes[self.i] > 0 else None
+
+    @property
+    def scan(self):
+        return self.batch.scan(self.i) if self.batch.episodes[self.i] > 0 else None
+
+    @property
+    def start(self) -> tuple[float, float, float]:
+        return tuple(float(v) for v in self.batch.starts[self.i])
+
+    @property
+    def sensor(self):
+        return self.batch.sensor(self.i)
+
+    @property
+    def max_speed(self) -> float:
+        return float(self.batch.max_speed[self.i])
+
+    @property
+    def elapsed(self) -> int:
+        return int(self.batch.elapsed[self.i])
+
+    @property
+    def collided(self) -> bool:
+        return bool(self.batch.collided[self.i])
+
+
+_KINDS = {"Placement": "placement", "Navigate": "navigate", "Recognize": "recognize"}
+
+
+def _kind(batch) -> str:
+    name = type(batch).__name__.replace("Batch", "")
+    if name not in _KINDS:
+        raise TypeError(f"OraclePolicy supports the sensorplan envs, got a {type(batch).__name__}")
+    return _KINDS[name]
+
+
 class OraclePolicy:
     """Privileged planner with an SB3-style ``predict``.
 
     Parameters
     ----------
-    env : a Gymnasium env of this package (wrappers are looked through) or an SB3
-        ``DummyVecEnv`` of them.  ``SubprocVecEnv`` cannot be read from and is rejected.
+    env : a Gymnasium env of this package (wrappers are looked through), an SB3
+        ``DummyVecEnv`` of them, a native vector env (``gym.make_vec``,
+        :class:`sensorplan_gym.envs.vector.SensorPlanVectorEnv`) or the SB3
+        :class:`agents.learning.vecenv.BatchedVecEnv` over one.  ``SubprocVecEnv`` cannot be
+        read from and is rejected.
+
+    The policy tells a new episode from the next step of the current one by itself: each
+    sub-environment counts the episodes it started (``batch.episodes``), so ``predict`` in a
+    plain loop (no ``episode_start``) never carries a plan into the next episode.
     """
 
     def __init__(self, env) -> None:
@@ -316,22 +480,39 @@ class OraclePolicy:
             raise TypeError(
                 "OraclePolicy needs in-process envs: use DummyVecEnv, not SubprocVecEnv"
             )
-        self.vectorized = envs is not None
-        self.envs = [e.unwrapped for e in (envs if envs is not None else [env])]
+        vec = env
+        while envs is None and not hasattr(vec, "batch") and hasattr(vec, "venv"):
+            vec = vec.venv  # SB3 wrappers (VecMonitor, ...), agents.learning.vecenv.BatchedVecEnv
+        vec = getattr(vec, "unwrapped", vec)
+        if envs is None and hasattr(vec, "batch") and hasattr(vec, "num_envs"):
+            batch = vec.batch  # a native vector env: one view per sub-environment
+            self.vectorized = True
+            self.envs = [_SubEnv(batch, i) for i in range(batch.n)]
+        else:
+            self.vectorized = envs is not None
+            self.envs = [e.unwrapped for e in (envs if envs is not None else [env])]
         for e in self.envs:
-            kind = type(e).__name__
-            if kind not in ("PlacementEnv", "NavigateEnv", "RecognizeEnv"):
-                raise TypeError(f"OraclePolicy supports the sensorplan envs, got {kind}")
-            if getattr(e.batch, "action_type", "continuous") != "continuous":
+            batch = getattr(e, "batch", None)
+            if batch is None:
+                raise TypeError(
+                    f"OraclePolicy supports the sensorplan envs, got {type(e).__name__}"
+                )
+            e.spec_kind = _kind(batch)
+            if getattr(batch, "action_type", "continuous") != "continuous":
                 raise TypeError(
                     "OraclePolicy acts in the continuous action space; make the env with "
                     "action_type='continuous' (the default)"
                 )
-            e.spec_kind = kind.replace("Env", "").lower()
         self.drivers = [_Driver(e) for e in self.envs]
 
+    @staticmethod
+    def _episode(env) -> int:
+        """The number of episodes ``env`` (a single env or a :class:`_SubEnv`) has started."""
+        i = env.i if isinstance(env, _SubEnv) else 0
+        return int(env.batch.episodes[i])
+
     def reset(self) -> None:
-        """Forget all episode state (called automatically at episode starts)."""
+        """Forget all episode state (not needed between episodes: ``predict`` notices them)."""
         self.drivers = [_Driver(e) for e in self.envs]
 
     def predict(
@@ -341,7 +522,11 @@ class OraclePolicy:
         episode_start: Any = None,
         deterministic: bool = True,
     ) -> tuple[np.ndarray, Any]:
-        """Actions for the current state of the bound env(s); ``(actions, state)`` as in SB3."""
+        """Actions for the current state of the bound env(s); ``(actions, state)`` as in SB3.
+
+        ``observation`` is not read (the oracle reads the env); ``episode_start`` may be
+        given, as SB3 does, but is not needed.  Raises ``RuntimeError`` when an env has not
+        been reset yet."""
         starts = (
             np.zeros(len(self.envs), dtype=bool)
             if episode_start is None
@@ -349,18 +534,17 @@ class OraclePolicy:
         )
         actions = []
         for i, env in enumerate(self.envs):
+            ep = self._episode(env)
+            if ep == 0:
+                raise RuntimeError(
+                    f"OraclePolicy.predict: sub-environment {i} has not been reset; "
+                    "call env.reset() first"
+                )
             drv = self.drivers[i]
             new = bool(starts[i]) if i < len(starts) else False
-            if (
-                not new
-                and env.spec_kind != "placement"
-                and drv.steps > 0
-                and env.pose is not None
-                and np.allclose(env.pose, env.start, atol=0)
-            ):
-                new = True  # the env was reset behind our back
-            if new:
+            if new or drv.episode != ep:
                 drv = self.drivers[i] = _Driver(env)
+                drv.episode = ep
             actions.append(self._act(env, drv))
             drv.steps += 1
         out = np.stack(actions)
@@ -378,7 +562,7 @@ class OraclePolicy:
         # Recognize: look once there, sweep the fan of beams, then decide
         decide = 0.0
         horizon = env.max_steps or (env.spec.max_episode_steps if env.spec else None) or 200
-        final = drv.steps >= horizon - 1
+        final = env.elapsed >= horizon - 1
         drv.looking = drv.looking or drv.arrived
         if drv.latched:
             decide = drv.latched

@@ -32,7 +32,7 @@ import numpy as np
 from .kernels import HAVE_NUMBA, numba
 from .segments import PAD
 
-__all__ = ["NEED", "TRIES", "TargetTables", "place_targets"]
+__all__ = ["NEED", "TRIES", "TargetTables", "place_targets", "targets_clear"]
 
 #: attempts at a placement clear of the robot
 TRIES = 20
@@ -188,11 +188,23 @@ def _dist_placed(px, py, poly, i, m):
     return math.sqrt(best)
 
 
+def targets_clear(idx, P, radius, poly, nv, out):
+    """``out[k]`` = whether the robot of row ``idx[k]`` (a disc of ``radius`` at ``P[0:2,
+    i]``) keeps clear of its placed target ``poly[i, :nv[i]]`` by more than ``1e-9``.  False
+    where every attempt of :func:`place_targets` met the robot (G or H a point whose target
+    covers the start)."""
+    lim = radius + 1e-9
+    for k in range(idx.shape[0]):
+        i = idx[k]
+        out[k] = _dist_placed(P[0, i], P[1, i], poly, i, nv[i]) > lim
+
+
 if HAVE_NUMBA:  # pragma: no cover - exercised when numba is installed
     _jit = numba.njit(cache=True, nogil=True, error_model="numpy")
     _poly_distance = _jit(_poly_distance)
     _dist_placed = _jit(_dist_placed)
     place_targets = _jit(place_targets)
+    targets_clear = _jit(targets_clear)
 
 
 class TargetTables:

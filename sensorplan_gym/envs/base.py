@@ -265,6 +265,9 @@ class SensorPlanBatch(BatchSim):
         self.actions = make_actions(action_type, self.action_task, self.action_dim, **action_kw)
         self.action_type = action_type
         self.single_action_space = self.actions.space
+        # episodes started per sub-environment: a planner bound to the env tells a new
+        # episode from the next step of the current one by it (agents.planning.oracle)
+        self.episodes = np.zeros(self.n, dtype=np.int64)
         self.random = isinstance(scene, str) and scene == "random"
         if not isinstance(min_start_distance, (int, float)) or not 0 <= min_start_distance < 1:
             raise ValueError(f"min_start_distance must be in [0, 1), got {min_start_distance!r}")
@@ -313,6 +316,7 @@ class SensorPlanBatch(BatchSim):
             self.load_worlds(idx, [w for w, _ in drawn])
             self.starts[idx] = [s for _, s in drawn]
         self.elapsed[idx] = 0
+        self.episodes[idx] += 1
         self._reset_rows(idx, options)
         self._after_reset(idx)
 

@@ -46,10 +46,11 @@ import math
 from typing import Any
 
 import numpy as np
+import shapely
 
 from ..core import fused
 from ..core.segments import SegmentRows, pad_segments, point_segment_distance, segment_normals
-from ..core.targets import TargetTables, place_targets
+from ..core.targets import TargetTables, place_targets, targets_clear
 from .base import RobotBatch, SensorPlanEnv
 
 __all__ = ["RecognizeBatch", "RecognizeEnv"]
@@ -151,6 +152,36 @@ class RecognizeBatch(RobotBatch):
             T.poly,
         )
         self.placed[idx] = True
+        clear = np.empty(len(idx), dtype=bool)
+        targets_clear(idx, self.P, self.robot_radius, T.poly, T.nv, clear)
+        for i in idx[~clear].tolist():
+            # every draw met the robot (G or H a point whose target covers the start): start
+            # elsewhere rather than inside a solid object
+            self._start_clear_of(i, shapely.Polygon(T.poly[i, : T.nv[i]]))
+
+    def _start_clear_of(self, i: int, target: shapely.Polygon) -> None:
+        """Move sub-environment ``i``'s robot to a start drawn from its generator as
+        ``random_start`` draws one (free, outside the region, in a part of the free space
+        that reaches it), that also keeps the robot disc clear of ``target``.  Raises
+        ``RuntimeError`` when 10,000 draws find none."""
+        w = self.worlds[i]
+        rng = self.rngs[i]
+        comps = shapely.get_parts(w.robot_space)
+        space = shapely.union_all(comps[shapely.intersects(comps, w.region)])
+        keep = target.buffer(w.robot_radius + 1e-6 * w.diameter)
+        for _ in range(10_000):
+            x = float(rng.uniform(w.lo[0], w.hi[0]))
+            y = float(rng.uniform(w.lo[1], w.hi[1]))
+            if (
+                shapely.contains_xy(space, x, y)
+                and not w.in_region(x, y)
+                and not shapely.contains_xy(keep, x, y)
+            ):
+                self.set_pose(i, (x, y, float(rng.uniform(-math.pi, math.pi))))
+                return
+        raise RuntimeError(
+            f"scene {w.scene.name!r}: no start outside the region keeps clear of the target"
+        )
 
     def _reset_rows(self, idx: np.ndarray, options: dict) -> None:
         self._reset_starts(idx, {})
