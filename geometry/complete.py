@@ -119,7 +119,7 @@ def _complete(scene: Scene, spec: TargetSpec) -> shapely.Geometry:
     if len(wedges):
         shapely.prepare(vis)
         wedges = wedges[shapely.intersects(vis, wedges)]
-    shadow = shapely.union_all(wedges) if len(wedges) else shapely.Polygon()
+    shadow = union_all(wedges) if len(wedges) else shapely.Polygon()
     blocked = shapely.union(shadow, spec.area)
     return polygonal(shapely.difference(vis, blocked))
 

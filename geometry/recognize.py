@@ -230,7 +230,7 @@ def overlap_strips(
             a, b = target[j], target[(j + 1) % len(target)]
             pts = np.concatenate([tri + a, tri + b], axis=1)  # (T, 6, 2)
             parts.append(shapely.convex_hull(shapely.multipoints(pts)))
-        strip = shapely.union_all(np.concatenate(parts))
+        strip = union_all(np.concatenate(parts))
         if rho > 0:
             strip = shapely.buffer(strip, rho, join_style="mitre", mitre_limit=2.0)
         out.append(strip)

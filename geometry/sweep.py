@@ -602,7 +602,7 @@ class Sweeper:
         e = np.roll(r, -1, axis=0)
         d = qb - qa
         par = shapely.polygons(np.stack([r, e, e + d, r + d], axis=1))
-        core = polygonal(shapely.difference(core, shapely.union_all(par)))
+        core = polygonal(shapely.difference(core, union_all(par)))
         if core.is_empty:
             return None
         parts = shapely.get_parts(core)

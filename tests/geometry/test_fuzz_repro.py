@@ -45,8 +45,6 @@ OPEN: dict[str, str] = {
     "fuzz-leak-P_stat-outside-free-space": "26.7 partial region inside an obstacle",
     "fuzz-variance-C_trans": "26.9 frame variance",
     "fuzz-variance-P_stat": "26.9 frame variance",
-    "fuzz-crash-P_stat-GEOSException-shapely_set_operations.py": "26.8 GEOS crash",
-    "fuzz-crash-R_part-GEOSException-shapely_set_operations.py": "26.8 GEOS crash",
     "recognizable_not_in_RG": "25.7 recognizable not inside R(G)",
     "recognizable_moves_with_frame": "25.7 recognizable moves with the frame",
     "scaled_crash": "25.7 sorted_gaps crash at 1e-3 scale",
