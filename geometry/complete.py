@@ -37,6 +37,7 @@ from ._common import (
     target_spec,
 )
 from ._frame import world_messages
+from ._shapes import union_all
 from ._vis import visibility_polygon
 
 if TYPE_CHECKING:  # pragma: no cover

@@ -42,7 +42,7 @@ from ._common import (
     target_spec,
 )
 from ._frame import world_messages
-from ._shapes import ccw_ring
+from ._shapes import ccw_ring, union_all
 from .complete import complete_region
 from .partial import ROTATING_PARTIAL, _swept_region, swept_tol
 from .weak import weak_visibility

@@ -57,7 +57,7 @@ from shapely import affinity
 from . import _libm
 from . import visindex as _visindex
 from ._common import polygonal
-from ._shapes import areal
+from ._shapes import areal, union_all
 from ._shapes import cross as _cross
 from ._vis import TAU, Domain, RayEscapeError, gaps_many
 from .weak import ENV as _ENV

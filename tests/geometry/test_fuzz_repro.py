@@ -47,7 +47,6 @@ OPEN: dict[str, str] = {
     "fuzz-variance-P_stat": "26.9 frame variance",
     "recognizable_not_in_RG": "25.7 recognizable not inside R(G)",
     "recognizable_moves_with_frame": "25.7 recognizable moves with the frame",
-    "scaled_crash": "25.7 sorted_gaps crash at 1e-3 scale",
 }
 
 #: Files that are not correctness cases (speed reports, issue 25 item 1).
@@ -195,7 +194,9 @@ def test_repro(name: str) -> None:
             kw2["target_at"] = (*to_alt(x, y), th)
         r1 = _run(scene, func, kw)
         r2 = _run(alt, func, kw2)
-        back = shapely.transform(r2, lambda c: (c - np.array([ox2, oy2])) / s2 * s1 + np.array([ox1, oy1]))
+        back = shapely.transform(
+            r2, lambda c: (c - np.array([ox2, oy2])) / s2 * s1 + np.array([ox1, oy1])
+        )
         sym = shapely.symmetric_difference(r1, back).area
         assert sym <= AREA_TOL_REL * _d2(scene), f"symdiff {sym / _d2(scene):.3e} D^2"
         return
@@ -248,7 +249,10 @@ def _issue25_case(name: str, path: Path) -> None:
             ex = shapely.difference(rec, big).area
             assert ex <= AREA_TOL_REL * d2, f"recognizable minus {what}: {ex / d2:.3e} D^2"
     elif name == "recognizable_moves_with_frame":
-        v = [float(t) for t in re.findall(r"translated by \(([-\d.e+]+), ([-\d.e+]+)\)", d["call"])[0]]
+        v = [
+            float(t)
+            for t in re.findall(r"translated by \(([-\d.e+]+), ([-\d.e+]+)\)", d["call"])[0]
+        ]
         moved = _transformed(d["scene"], 1.0, v)
         r1 = recognizable_region(scene, model="partial", theta=0.0)
         r2 = recognizable_region(Scene.from_dict(moved), model="partial", theta=0.0)
