@@ -73,6 +73,10 @@ ALLOWED_KEYS = REQUIRED_KEYS + OPTIONAL_KEYS
 SENSOR_KEYS = ("fov_deg", "max_range", "eps_pos", "eps_aim_deg", "range_acc", "normal_acc_deg")
 #: Sensor fields measured in scene units (scaled with the scene into its local frame).
 _LENGTH_SENSOR_KEYS = ("max_range", "eps_pos", "range_acc")
+#: Largest accepted coordinate magnitude (scene units): the cross products and areas the
+#: region algorithms form must stay finite (1e300 coordinates used to be reported as a
+#: "zero-area polygon", issue 26 item 10).
+MAX_COORD = 1e100
 #: Default range accuracy relative to the scene's diameter (``range_acc: null``).
 RANGE_ACC_REL = 1e-6
 #: Default normal accuracy in degrees.
@@ -164,6 +168,11 @@ def _parse_points(value: Any, where: str, *, allow_point: bool = False) -> np.nd
                 raise SceneError(f"{where}[{i}]: coordinates must be numbers, got {_short(c)}")
             if not math.isfinite(c):
                 raise SceneError(f"{where}[{i}]: non-finite coordinate {c!r}")
+            if abs(c) > MAX_COORD:
+                raise SceneError(
+                    f"{where}[{i}]: coordinate {c!r} is beyond +-{MAX_COORD:g}: products of "
+                    "such coordinates (areas, cross products) overflow double precision"
+                )
         pts.append((float(v[0]), float(v[1])))
     n = len(pts)
     if allow_point and n == 1:
@@ -557,13 +566,15 @@ class Scene:
                 f"{which}: CH(A ⊕ {sym}) (convex hull of the target's swept area at orientation 0)",
             )
         if self.start is not None:
-            p = Point(self.start[0], self.start[1])
-            v = self._violation(p if ref_inside else self.target_at(*self.start))
+            # ``start`` is the sensor robot's pose, not the target's: its point must lie in
+            # the free space whatever the target's shape or reference point (issue 25 item
+            # 5: the target's footprint was placed there and valid scenes were rejected).
+            # The scene does not know the robot's footprint; callers that do check it.
+            v = self._violation(Point(self.start[0], self.start[1]))
             if v is not None:
-                what = "" if ref_inside else " (the target placed there)"
                 raise SceneError(
-                    f"start: {_fmt_pt(self.start[0], self.start[1])}{what} is not in the free "
-                    f"space (bounds minus obstacles): meets {v[0]}"
+                    f"start: {_fmt_pt(self.start[0], self.start[1])} is not in the free space "
+                    f"(bounds minus obstacles): meets {v[0]} (start is the sensor robot's pose)"
                 )
 
     # -- read-only-ness, equality, pickling ------------------------------------------------------
