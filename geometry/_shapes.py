@@ -5,11 +5,22 @@ variants with different rules had grown apart)."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import shapely
 import shapely.errors
 
-__all__ = ["DISC_SIDES", "areal", "ccw_ring", "cross", "disc_sum", "polygonal", "union_all"]
+__all__ = [
+    "DISC_SIDES",
+    "areal",
+    "ccw_ring",
+    "cross",
+    "disc_sum",
+    "polygonal",
+    "snap_grid",
+    "union_all",
+]
 
 #: Sides of the polygon that stands for a disc (circumscribed: it contains the disc and its
 #: boundary lies within R (1/cos(pi/DISC_SIDES) - 1) = 0.0012 R of the circle).
@@ -25,7 +36,20 @@ SLIVER = 1e-10
 SNAP_REL = 1e-13
 
 
-def union_all(geoms: object, scale: float = 1.0) -> shapely.Geometry:
+def snap_grid(pts: np.ndarray) -> float:
+    """The snap-rounding grid of a scene whose vertices are ``pts``: ``SNAP_REL`` times the
+    diameter of their box, but never below 2**-50 of the largest coordinate (so that
+    coordinate / grid stays exact in a double, e.g. at UTM offsets)."""
+    p = np.asarray(pts, dtype=float)
+    lo, hi = p.min(axis=0), p.max(axis=0)
+    diam = float(np.hypot(*(hi - lo)))
+    big = float(np.abs(p).max())
+    return max(SNAP_REL * diam, math.ldexp(big, -50), 1e-300)
+
+
+def union_all(
+    geoms: object, scale: float = 1.0, grid_size: float | None = None
+) -> shapely.Geometry:
     """``shapely.union_all`` that does not raise on near-coincident edges.
 
     GEOS's floating overlay can fail ("TopologyException: side location conflict") on
@@ -34,7 +58,10 @@ def union_all(geoms: object, scale: float = 1.0) -> shapely.Geometry:
     is GEOS's snap-rounding overlay (OverlayNG with a fixed grid), which is robust by
     construction; its grid ``SNAP_REL * scale`` moves every vertex by at most half of
     it, far below the answers' tolerance.  ``scale``: the geometry's size (the local
-    frame's scenes have scale about 1)."""
+    frame's scenes have scale about 1).  With ``grid_size`` the snap-rounding overlay is
+    used directly."""
+    if grid_size is not None:
+        return shapely.union_all(geoms, grid_size=grid_size)
     try:
         return shapely.union_all(geoms)
     except shapely.errors.GEOSException:

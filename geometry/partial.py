@@ -166,8 +166,9 @@ def _partial_region(
     # clipped to the free space: an anchor on a target edge that lies flush against an
     # obstacle (touching within the scene's tolerance) may be inside that obstacle by
     # rounding, and its fan then fills the obstacle (issue 10, fuzz seed 223)
-    allowed = shapely.difference(scene.free_space, spec.area)
-    region = polygonal(shapely.intersection(region, allowed))
+    g = scene.snap  # snap-rounding overlays: exact contacts (docs/DESIGN.md, "Contacts")
+    allowed = shapely.difference(scene.free_space, spec.area, grid_size=g)
+    region = polygonal(shapely.intersection(region, allowed, grid_size=g))
     if eps_pos > 0:
         region = shrink_for_position(region, allowed, eps_pos)
     return region
@@ -207,8 +208,9 @@ def _swept_region(
     if conservative:
         # tol: the traced arcs' chords; grid: the snap-rounding of the union (sweep.py)
         shadows = disc_sum(shadows, tol + stats["grid"])
-    allowed = shapely.difference(scene.free_space, spec.area)
-    out = polygonal(shapely.difference(allowed, shadows))
+    g = scene.snap  # snap-rounding overlays: exact contacts (docs/DESIGN.md, "Contacts")
+    allowed = shapely.difference(scene.free_space, spec.area, grid_size=g)
+    out = polygonal(shapely.difference(allowed, shadows, grid_size=g))
     if eps_pos > 0:
         out = shrink_for_position(out, allowed, eps_pos)
     return out

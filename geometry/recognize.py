@@ -159,7 +159,8 @@ def _recognizable_region(
         ring_cw, wanted_cw = ring[::-1], np.roll(wanted[::-1], -1)
         reg = weak_visibility(scene_domain(scene), ring_cw, wanted_cw, eps_aim)
         # clipped to the free space (see partial._partial_region)
-        reg = polygonal(shapely.intersection(reg, shapely.difference(scene.free_space, spec.area)))
+        allowed = shapely.difference(scene.free_space, spec.area, grid_size=scene.snap)
+        reg = polygonal(shapely.intersection(reg, allowed, grid_size=scene.snap))
         if eps_pos > 0:
             reg = shrink_for_position(reg, shapely.difference(scene.free_space, spec.area), eps_pos)
         regions.append(reg)

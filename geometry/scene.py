@@ -54,7 +54,7 @@ from shapely.geometry import MultiPolygon, Point, Polygon
 from shapely.geometry.base import BaseGeometry
 
 from ._frame import IDENTITY, Frame, frame_params, to_world_point, world_messages
-from ._shapes import areal
+from ._shapes import areal, snap_grid
 
 __all__ = ["SceneError", "SensorSpec", "Scene", "TOL_REL", "PAPER_ASSUMPTION"]
 
@@ -679,14 +679,24 @@ class Scene:
         """Union of all obstacles (touching/overlapping ones merged); ``Polygon()`` if none."""
         if not self.obstacles:
             return Polygon()
-        return _polygonal(shapely.union_all(self.obstacle_geoms))
+        return _polygonal(shapely.union_all(self.obstacle_geoms, grid_size=self.snap))
 
     @functools.cached_property
     def free_space(self) -> Polygon | MultiPolygon:
         """Bounds minus the obstacle union (a Polygon, or a MultiPolygon if disconnected)."""
         if self.obstacle_union.is_empty:
             return self.bounds_geom
-        return _polygonal(self.bounds_geom.difference(self.obstacle_union))
+        return _polygonal(
+            shapely.difference(self.bounds_geom, self.obstacle_union, grid_size=self.snap)
+        )
+
+    @functools.cached_property
+    def snap(self) -> float:
+        """Grid of the snap-rounded overlays that build :attr:`obstacle_union` and
+        :attr:`free_space` (``SNAP_REL = 1e-13`` of the diameter; docs/DESIGN.md, "Contacts").
+        GEOS's floating overlay can put a flush sliver obstacle both inside and outside
+        a wall at once (issue 26 item 7); the snap-rounding overlay cannot."""
+        return snap_grid(self.bounds)
 
     @functools.cached_property
     def goal_geom(self) -> Polygon | Point:
