@@ -34,7 +34,6 @@ AREA_TOL_REL = 1e-7
 
 #: Cases not fixed yet: strict xfail, with the reason.
 OPEN: dict[str, str] = {
-    "fuzz-disagree-C_stat-lib_in_truth_out": "26.6 unsafe complete at UTM: contact rule",
     "fuzz-disagree-C_trans-lib_out_truth_in": "26.1 near-duplicate target vertices",
     "fuzz-disagree-P_stat-lib_out_truth_in": "26.2 flush obstacles over both ends of an edge",
     "fuzz-disagree-P_swept-lib_in_truth_out": "26.3 swept partial unsafe",
@@ -42,7 +41,6 @@ OPEN: dict[str, str] = {
     "fuzz-inclusion-complete__partial": "26.5 complete not inside partial",
     "fuzz-inclusion-recognizable_partial__partial_G_": "26.4 recognizable not inside R(G)",
     "fuzz-inclusion-swept_partial__stationary_partial_aux_": "26.3 swept not inside stationary",
-    "fuzz-variance-C_trans": "26.9 frame variance",
     "fuzz-variance-P_stat": "26.9 frame variance",
     "recognizable_not_in_RG": "25.7 recognizable not inside R(G)",
     "recognizable_moves_with_frame": "25.7 recognizable moves with the frame",
