@@ -28,8 +28,18 @@ demands equality up to the output's rounding.
   back, differs from the original by more than 1e-9 D^2;
 * ``hang``: a query that took more than 10 s of CPU time (scenes of at most 60 edges).
 
-``python -m geometry.fuzz --n 10000 [--swept] [--seed 0]`` runs the long version and
-prints a table; ``tests/geometry/test_fuzz.py`` runs a fast one in the default test run.
+* ``frame`` (``frames=True``, issue 26): the scene scaled by 1e-3 and 1e3 and moved to UTM
+  coordinates (inexact maps: the inputs differ by rounding), regions mapped back, differ
+  by more than 1e-7 D^2; with ``swept`` and polygonal G/H also the 5.2 region ⊆ R(G), R(H)
+  and ⊆ the stationary recognizable region of a vertex pair.
+
+``contacts=True`` (``--contacts``) adds the scene families issue 26 found missing:
+near-duplicate target vertices, flush obstacles over both ends of a target edge, a target
+under an opening, a second obstacle sharing a flush one's edge.
+
+``python -m geometry.fuzz --n 10000 [--swept] [--contacts] [--frames] [--seed 0]`` runs the
+long version and prints a table; ``tests/geometry/test_fuzz.py`` runs a fast one in the
+default test run.
 """
 
 from __future__ import annotations

@@ -216,6 +216,25 @@ def _parse_points(value: Any, where: str, *, allow_point: bool = False) -> np.nd
     return _readonly(a)
 
 
+def _merge_near(a: np.ndarray, where: str, tol: float) -> np.ndarray:
+    """The CCW ring ``a`` with every vertex closer than ``tol`` (``TOL_REL`` times the
+    scene's diameter) to the previous kept vertex dropped (docs/DESIGN.md, "Contacts"): two target
+    vertices 1e-9 D apart made an edge whose direction is rounding noise, and the region
+    algorithms took it for a real edge (issue 26 item 1).  Raises ``SceneError`` when
+    fewer than 3 vertices remain."""
+    keep = [0]
+    for i in range(1, len(a)):
+        if np.abs(a[i] - a[keep[-1]]).max() > tol:
+            keep.append(i)
+    while len(keep) > 1 and np.abs(a[keep[-1]] - a[keep[0]]).max() <= tol:
+        keep.pop()
+    if len(keep) == len(a):
+        return a
+    if len(keep) < 3:
+        raise SceneError(f"{where}: fewer than 3 vertices more than {tol:.3g} apart")
+    return _readonly(a[keep].copy())
+
+
 # ---------------------------------------------------------------------------------------------
 # sensor
 # ---------------------------------------------------------------------------------------------
@@ -479,7 +498,8 @@ class Scene:
         if not isinstance(obs_in, list):
             raise SceneError(f"obstacles: expected a list of polygons, got {_short(obs_in)}")
         obstacles = tuple(_parse_points(o, f"obstacles[{i}]") for i, o in enumerate(obs_in))
-        target = _parse_points(d["target"], "target")
+        diam = float(np.hypot(*np.ptp(bounds, axis=0)))
+        target = _merge_near(_parse_points(d["target"], "target"), "target", TOL_REL * diam)
         goal = _parse_points(d["goal"], "goal", allow_point=True)
         failure = _parse_points(d["failure"], "failure", allow_point=True)
         sensor = SensorSpec.from_dict(d.get("sensor"))

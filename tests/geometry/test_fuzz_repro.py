@@ -34,7 +34,6 @@ AREA_TOL_REL = 1e-7
 
 #: Cases not fixed yet: strict xfail, with the reason.
 OPEN: dict[str, str] = {
-    "fuzz-disagree-C_trans-lib_out_truth_in": "26.1 near-duplicate target vertices",
     "fuzz-disagree-P_stat-lib_out_truth_in": "26.2 flush obstacles over both ends of an edge",
     "fuzz-disagree-P_swept-lib_in_truth_out": "26.3 swept partial unsafe",
     "fuzz-disagree-R_part-lib_out_truth_in": "26.2 target under an opening",
