@@ -120,10 +120,10 @@ def _complete(scene: Scene, spec: TargetSpec) -> shapely.Geometry:
     if len(wedges):
         shapely.prepare(vis)
         wedges = wedges[shapely.intersects(vis, wedges)]
-    g = scene.snap  # snap-rounding overlays: exact contacts (docs/DESIGN.md, "Contacts")
-    shadow = union_all(wedges, grid_size=g) if len(wedges) else shapely.Polygon()
-    blocked = shapely.union(shadow, spec.area, grid_size=g)
-    return polygonal(shapely.difference(vis, blocked, grid_size=g))
+    shadow = union_all(wedges) if len(wedges) else shapely.Polygon()
+    blocked = shapely.union(shadow, spec.area)
+    # the final clip snap-rounded: exact contacts (docs/DESIGN.md, "Contacts")
+    return polygonal(shapely.difference(vis, blocked, grid_size=scene.snap))
 
 
 def tangent_wedges(
