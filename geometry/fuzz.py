@@ -614,7 +614,8 @@ def check_scene(
     return out, times
 
 
-#: The frames of :func:`_check_frames`: ``world = k * scene + (ox, oy)``.
+#: The frames of :func:`_check_frames`: ``world = k * scene + (ox, oy)`` (for ``utm`` the
+#: scene is first scaled by a power of two to a diameter of about 10).
 FRAMES = {
     "scale1e-3": (1e-3, 0.0, 0.0),
     "scale1e3": (1e3, 0.0, 0.0),
@@ -649,6 +650,10 @@ def _check_frames(
     1e-7 D^2 (findings ``frame``)."""
     D = s.diameter
     for fname, (k, ox, oy) in FRAMES.items():
+        if fname == "utm":
+            # a room of about 10 m first (an exact power-of-two scale): a 1e-6 m scene at
+            # 5e6 m has no digits left, which is not the question
+            k = math.ldexp(1.0, round(math.log2(10.0 / D)))
         try:
             t = Scene.from_dict(_mapped(d, k, ox, oy))
         except SceneError as e:
