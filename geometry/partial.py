@@ -208,9 +208,9 @@ def _swept_region(
     if conservative:
         # tol: the traced arcs' chords; grid: the snap-rounding of the union (sweep.py)
         shadows = disc_sum(shadows, tol + stats["grid"])
-    g = scene.snap  # snap-rounding overlays: exact contacts (docs/DESIGN.md, "Contacts")
-    allowed = shapely.difference(scene.free_space, spec.area, grid_size=g)
-    out = polygonal(shapely.difference(allowed, shadows, grid_size=g))
+    # floating overlay: the shadows are already snap-rounded on the sweep's own grid
+    allowed = shapely.difference(scene.free_space, spec.area)
+    out = polygonal(shapely.difference(allowed, shadows))
     if eps_pos > 0:
         out = shrink_for_position(out, allowed, eps_pos)
     return out

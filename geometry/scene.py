@@ -699,13 +699,22 @@ class Scene:
         """Union of all obstacles (touching/overlapping ones merged); ``Polygon()`` if none."""
         if not self.obstacles:
             return Polygon()
-        return _polygonal(shapely.union_all(self.obstacle_geoms, grid_size=self.snap))
+        return _polygonal(shapely.union_all(self.obstacle_geoms))
 
     @functools.cached_property
     def free_space(self) -> Polygon | MultiPolygon:
-        """Bounds minus the obstacle union (a Polygon, or a MultiPolygon if disconnected)."""
+        """Bounds minus the obstacle union (a Polygon, or a MultiPolygon if disconnected).
+
+        GEOS's floating overlay can keep a sliver obstacle flush on a wall as free space
+        (it judged the obstacle both inside and outside the bounds, issue 26 item 7); when
+        an obstacle's interior point is in the floating result, the snap-rounding overlay
+        on the grid :attr:`snap` is used instead (docs/DESIGN.md, "Contacts")."""
         if self.obstacle_union.is_empty:
             return self.bounds_geom
+        fs = _polygonal(self.bounds_geom.difference(self.obstacle_union))
+        inner = np.array([o.representative_point().coords[0] for o in self.obstacle_geoms])
+        if fs.is_valid and not shapely.contains_xy(fs, inner[:, 0], inner[:, 1]).any():
+            return fs
         return _polygonal(
             shapely.difference(self.bounds_geom, self.obstacle_union, grid_size=self.snap)
         )
