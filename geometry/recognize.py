@@ -42,7 +42,7 @@ from ._common import (
     target_spec,
 )
 from ._frame import world_messages
-from ._shapes import ccw_ring, union_all
+from ._shapes import areal, ccw_ring, union_all
 from .complete import complete_region
 from .partial import ROTATING_PARTIAL, _swept_region, swept_tol
 from .weak import weak_visibility
@@ -160,7 +160,7 @@ def _recognizable_region(
         reg = weak_visibility(scene_domain(scene), ring_cw, wanted_cw, eps_aim)
         # clipped to the free space (see partial._partial_region)
         allowed = shapely.difference(scene.free_space, spec.area, grid_size=scene.snap)
-        reg = polygonal(shapely.intersection(reg, allowed, grid_size=scene.snap))
+        reg = polygonal(shapely.intersection(areal(reg), areal(allowed), grid_size=scene.snap))
         if eps_pos > 0:
             reg = shrink_for_position(reg, shapely.difference(scene.free_space, spec.area), eps_pos)
         regions.append(reg)

@@ -142,6 +142,20 @@ def test_contact_generator_draws_the_issue26_families():
     assert fuzz_scene(27) == fuzz_scene(27, contacts=False)
 
 
+#: Contact-fuzz seeds that crashed during development: 540 -- the snap-rounded clip of the
+#: stationary partial region got the fans' union with a collapsed line in it (GEOS "Overlay
+#: input is mixed-dimension"); the areal parts are clipped now.
+CONTACT_REGRESSION_SEEDS = [540]
+
+
+@pytest.mark.parametrize("seed", CONTACT_REGRESSION_SEEDS)
+def test_contact_regression_seeds(seed):
+    d = fuzz_scene(seed, contacts=True)
+    findings, _ = check_scene(d, seed=seed, hang_s=60.0, frames=True)
+    bad = [vars(f) for f in findings if f.kind in CONTACT_CLEAN]
+    assert not bad, bad
+
+
 @settings(max_examples=15, deadline=None)
 @given(seed=st.integers(min_value=0, max_value=2**31 - 1))
 def test_fuzz_contacts_and_frames(seed):
