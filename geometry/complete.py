@@ -37,7 +37,7 @@ from ._common import (
     target_spec,
 )
 from ._frame import world_messages
-from ._shapes import areal, union_all
+from ._shapes import snapped, union_all
 from ._vis import visibility_polygon
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -123,7 +123,7 @@ def _complete(scene: Scene, spec: TargetSpec) -> shapely.Geometry:
     shadow = union_all(wedges) if len(wedges) else shapely.Polygon()
     blocked = shapely.union(shadow, spec.area)
     # the final clip snap-rounded: exact contacts (docs/DESIGN.md, "Contacts")
-    return polygonal(shapely.difference(areal(vis), areal(blocked), grid_size=scene.snap))
+    return polygonal(snapped(shapely.difference, vis, blocked, scene.snap))
 
 
 def tangent_wedges(

@@ -42,7 +42,7 @@ from ._common import (
     target_spec,
 )
 from ._frame import world_messages
-from ._shapes import areal, ccw_ring, disc_sum
+from ._shapes import ccw_ring, disc_sum, snapped
 from .sweep import swept_shadows
 from .weak import ENV, UNWANTED, WANTED, weak_visibility  # noqa: F401 (re-exported)
 
@@ -167,9 +167,9 @@ def _partial_region(
     # obstacle (touching within the scene's tolerance) may be inside that obstacle by
     # rounding, and its fan then fills the obstacle (issue 10, fuzz seed 223)
     g = scene.snap  # snap-rounding overlays: exact contacts (docs/DESIGN.md, "Contacts")
-    allowed = shapely.difference(scene.free_space, spec.area, grid_size=g)
+    allowed = snapped(shapely.difference, scene.free_space, spec.area, g)
     # (snap-rounding overlays take one dimension: the areal parts of the fans' union)
-    region = polygonal(shapely.intersection(areal(region), areal(allowed), grid_size=g))
+    region = polygonal(snapped(shapely.intersection, region, allowed, g))
     if eps_pos > 0:
         region = shrink_for_position(region, allowed, eps_pos)
     return region

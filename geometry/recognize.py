@@ -42,7 +42,7 @@ from ._common import (
     target_spec,
 )
 from ._frame import world_messages
-from ._shapes import areal, ccw_ring, union_all
+from ._shapes import ccw_ring, snapped, union_all
 from .complete import complete_region
 from .partial import ROTATING_PARTIAL, _swept_region, swept_tol
 from .weak import weak_visibility
@@ -159,8 +159,8 @@ def _recognizable_region(
         ring_cw, wanted_cw = ring[::-1], np.roll(wanted[::-1], -1)
         reg = weak_visibility(scene_domain(scene), ring_cw, wanted_cw, eps_aim)
         # clipped to the free space (see partial._partial_region)
-        allowed = shapely.difference(scene.free_space, spec.area, grid_size=scene.snap)
-        reg = polygonal(shapely.intersection(areal(reg), areal(allowed), grid_size=scene.snap))
+        allowed = snapped(shapely.difference, scene.free_space, spec.area, scene.snap)
+        reg = polygonal(snapped(shapely.intersection, reg, allowed, scene.snap))
         if eps_pos > 0:
             reg = shrink_for_position(reg, shapely.difference(scene.free_space, spec.area), eps_pos)
         regions.append(reg)
