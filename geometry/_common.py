@@ -16,6 +16,7 @@ import numpy as np
 import shapely
 from shapely import affinity
 
+from ._frame import to_world_point
 from ._shapes import disc_sum, polygonal
 from ._vis import Domain, domain_from_geometry
 
@@ -131,7 +132,7 @@ def target_spec(
             0.0,
             np.asarray(area.centroid.coords[0]),
             (x, y, th),
-            f"target at ({x:g}, {y:g}, {th:g})",
+            "target at ({:g}, {:g}, {:g})".format(*to_world_point(x, y), th),
         )
     else:
         region = _region(scene, target_in)
@@ -205,7 +206,18 @@ def check_theta(theta: Any, *, allow_none: bool = True) -> float | None:
     if not _real(theta) or not math.isfinite(float(theta)):
         want = "a finite number (radians) or None" if allow_none else "a finite number (radians)"
         raise ValueError(f"theta must be {want}, got {theta!r}")
-    return float(theta)
+    return _radians("theta", float(theta))
+
+
+def _radians(what: str, th: float) -> float:
+    """``th`` if it lies in [-2 pi, 2 pi]; else the error the JSON ``start`` gives (a value
+    like 90 is degrees by mistake, issues 25 item 6 and 26 item 10)."""
+    if abs(th) > 2 * math.pi:
+        raise ValueError(
+            f"{what}: {th!r} is outside [-2 pi, 2 pi]; orientations are in radians (did you "
+            f"mean {th!r} degrees = {math.radians(th):.6g} rad?)"
+        )
+    return th
 
 
 def check_pose(target_at: Any) -> tuple[float, float, float] | None:
@@ -221,6 +233,7 @@ def check_pose(target_at: Any) -> tuple[float, float, float] | None:
     x, y, th = (float(v) for v in vals)
     if not all(math.isfinite(v) for v in (x, y, th)):
         raise ValueError(f"target_at must be finite, got {target_at!r}")
+    _radians("target_at[2] (theta)", th)
     return x, y, th
 
 
@@ -283,11 +296,11 @@ class Budget:
 
 
 def check_eps(name: str, value: float) -> float:
-    """Validate a non-negative finite uncertainty bound and return it as float."""
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a number, got {value!r}") from None
+    """Validate a non-negative finite uncertainty bound and return it as float.  Only real
+    numbers are accepted (a string such as ``"0.1"`` or a bool is an error)."""
+    if not _real(value):
+        raise ValueError(f"{name} must be a number, got {value!r}")
+    v = float(value)
     if not math.isfinite(v) or v < 0:
         raise ValueError(f"{name} must be finite and >= 0, got {value!r}")
     return v

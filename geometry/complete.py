@@ -37,6 +37,7 @@ from ._common import (
     target_spec,
 )
 from ._frame import world_messages
+from ._shapes import snapped, union_all
 from ._vis import visibility_polygon
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -119,9 +120,10 @@ def _complete(scene: Scene, spec: TargetSpec) -> shapely.Geometry:
     if len(wedges):
         shapely.prepare(vis)
         wedges = wedges[shapely.intersects(vis, wedges)]
-    shadow = shapely.union_all(wedges) if len(wedges) else shapely.Polygon()
+    shadow = union_all(wedges) if len(wedges) else shapely.Polygon()
     blocked = shapely.union(shadow, spec.area)
-    return polygonal(shapely.difference(vis, blocked))
+    # the final clip snap-rounded: exact contacts (docs/DESIGN.md, "Contacts")
+    return polygonal(snapped(shapely.difference, vis, blocked, scene.snap))
 
 
 def tangent_wedges(
@@ -175,6 +177,14 @@ def tangent_wedges(
     a_hi = base + hi
     k_lo = _tangent_point(u, a_lo, k[i_lo], r)
     k_hi = _tangent_point(u, a_hi, k[i_hi], r)
+    if r <= 0 and len(k) > 1:
+        # the grazing test needs the tangent *line*: from a u nearly collinear with a hull
+        # edge, the nearest vertex on it gives a short baseline whose direction is decided
+        # by rounding (issue 26 item 6: 3.4e-4 long, 1e-11 off the edge, so the obstacle's
+        # own flush neighbour fell 3e-9 off the line).  Use the farthest hull vertex within
+        # ``tol`` of the line, the same line to within tol / baseline.
+        k_lo = _far_on_line(u, i_lo, k, tol)
+        k_hi = _far_on_line(u, i_hi, k, tol)
     touch, t_lo, t_hi = _touching_cones(u, k, r, tol)
     if touch.any():
         a_lo[touch], a_hi[touch] = t_lo, t_hi
@@ -247,6 +257,25 @@ def _touching_cones(
     lo = np.where(is_v, a1, lo)
     hi = np.where(is_v, a1 + (a2 - a1) % (2 * np.pi), hi)
     return touch, lo, hi
+
+
+def _far_on_line(u: np.ndarray, i: np.ndarray, k: np.ndarray, tol: float) -> np.ndarray:
+    """For each row: the tangent hull vertex ``k[i]``, or its hull neighbour ``c`` when
+    ``u`` lies within ``tol`` of the line of the hull edge ``c k[i]`` and ``c`` is farther
+    from ``u`` (then u, k[i] and c are one line to within tol)."""
+    m = len(k)
+    kt = k[i]
+    best = kt.copy()
+    best_len = np.hypot(*(kt - u).T)
+    for c in (k[(i - 1) % m], k[(i + 1) % m]):
+        e = kt - c
+        le = np.maximum(np.hypot(e[:, 0], e[:, 1]), 1e-300)
+        w = u - c
+        off = np.abs(e[:, 0] * w[:, 1] - e[:, 1] * w[:, 0]) / le
+        lc = np.hypot(*(c - u).T)
+        use = (off <= tol) & (lc > best_len)
+        best[use], best_len[use] = c[use], lc[use]
+    return best
 
 
 def _tangent_point(u: np.ndarray, ang: np.ndarray, k: np.ndarray, radius: float) -> np.ndarray:

@@ -28,8 +28,18 @@ demands equality up to the output's rounding.
   back, differs from the original by more than 1e-9 D^2;
 * ``hang``: a query that took more than 10 s of CPU time (scenes of at most 60 edges).
 
-``python -m geometry.fuzz --n 10000 [--swept] [--seed 0]`` runs the long version and
-prints a table; ``tests/geometry/test_fuzz.py`` runs a fast one in the default test run.
+* ``frame`` (``frames=True``, issue 26): the scene scaled by 1e-3 and 1e3 and moved to UTM
+  coordinates (inexact maps: the inputs differ by rounding), regions mapped back, differ
+  by more than 1e-7 D^2; with ``swept`` and polygonal G/H also the 5.2 region ⊆ R(G), R(H)
+  and ⊆ the stationary recognizable region of a vertex pair.
+
+``contacts=True`` (``--contacts``) adds the scene families issue 26 found missing:
+near-duplicate target vertices, flush obstacles over both ends of a target edge, a target
+under an opening, a second obstacle sharing a flush one's edge.
+
+``python -m geometry.fuzz --n 10000 [--swept] [--contacts] [--frames] [--seed 0]`` runs the
+long version and prints a table; ``tests/geometry/test_fuzz.py`` runs a fast one in the
+default test run.
 """
 
 from __future__ import annotations
@@ -227,9 +237,11 @@ def _place(rng: np.random.Generator, free: shapely.Geometry, clear: float) -> np
     return None
 
 
-def _region(rng: np.random.Generator, c: np.ndarray, size: float) -> list[list[float]]:
+def _region(
+    rng: np.random.Generator, c: np.ndarray, size: float, point: bool = False
+) -> list[list[float]]:
     kind = rng.integers(3)
-    if kind == 0:
+    if kind == 0 or point:
         return [c.tolist()]
     if kind == 1:
         s = size
@@ -243,13 +255,16 @@ def _snap(v: Any, grid: float) -> Any:
     return float(np.round(v / grid) * grid)
 
 
-def fuzz_scene(seed: int, *, max_edges: int = 60) -> dict[str, Any] | None:
+def fuzz_scene(seed: int, *, max_edges: int = 60, contacts: bool = False) -> dict[str, Any] | None:
     """A random degenerate scene dictionary (or ``None`` when the draw failed to give a
     valid scene after a few tries).  ``"features"`` (not a scene key; removed before
-    use) lists the degeneracies drawn."""
+    use) lists the degeneracies drawn.  ``contacts=True`` adds the families issue 26
+    found the generator blind to: near-duplicate target vertices (1e-9 of the target
+    apart), flush obstacles covering both ends of a target edge, a target flush under an
+    opening between two obstacles, and a second obstacle sharing the flush one's edge."""
     rng = np.random.default_rng(seed)
     for _ in range(8):
-        d = _draft_scene(rng, max_edges)
+        d = _draft_scene(rng, max_edges, contacts)
         if d is None:
             continue
         try:
@@ -260,7 +275,9 @@ def fuzz_scene(seed: int, *, max_edges: int = 60) -> dict[str, Any] | None:
     return None
 
 
-def _draft_scene(rng: np.random.Generator, max_edges: int) -> dict[str, Any] | None:
+def _draft_scene(
+    rng: np.random.Generator, max_edges: int, contacts: bool = False
+) -> dict[str, Any] | None:
     dr = _Draft(_bounds(rng))
     diam = float(np.hypot(*np.ptp(dr.bounds, axis=0)))
     for _ in range(int(rng.integers(0, 8))):
@@ -280,17 +297,25 @@ def _draft_scene(rng: np.random.Generator, max_edges: int) -> dict[str, Any] | N
         else:
             target = target + rng.uniform(-1.5 * r, 1.5 * r, 2)
         dr.features.append("reference_off")
+    if contacts and rng.random() < 0.3:
+        # near-duplicate target vertex: a copy of vertex i, 1e-9 D along its next edge
+        t = _ccw(target)
+        i = int(rng.integers(len(t)))
+        e = t[(i + 1) % len(t)] - t[i]
+        dup = t[i] + e * (1e-9 * diam / max(float(np.hypot(*e)), 1e-300))
+        target = np.insert(t, i + 1, dup, axis=0)
+        dr.features.append("near_dup_target")
     size = r * rng.uniform(0.5, 3.0)
     pg = _place(rng, free, 1.2 * r + 1.5 * size)
     if pg is None:
         return None
-    goal = _region(rng, pg, size)
+    goal = _region(rng, pg, size, point=contacts and rng.random() < 0.4)
     gpoly = shapely.Polygon(goal) if len(goal) > 1 else shapely.Point(goal[0])
     pf = _place(rng, free.difference(gpoly.buffer(2 * r + 2 * size)), 1.2 * r + 1.5 * size)
     if pf is None:
         return None
     failure = _region(rng, pf, size)
-    if rng.random() < 0.3 and len(goal) == 1:
+    if rng.random() < (0.15 if contacts else 0.3) and len(goal) == 1:
         # touch_hull: a triangle touching the target at G at a vertex or flush on an edge
         a = _ccw(target + np.asarray(goal[0]))
         i = int(rng.integers(len(a)))
@@ -302,6 +327,8 @@ def _draft_scene(rng: np.random.Generator, max_edges: int) -> dict[str, Any] | N
             tri = np.array([p, p + n + (q - p) * 0.5, p + n - (q - p) * 0.5])
         dr.obstacles.append(tri)
         dr.features.append("touch_hull")
+    elif contacts and len(goal) == 1 and rng.random() < 0.85:
+        _contact_family(rng, dr, _ccw(target + np.asarray(goal[0])), r)
     d: dict[str, Any] = {
         "name": "fuzz",
         "bounds": dr.bounds.tolist(),
@@ -324,6 +351,32 @@ def _draft_scene(rng: np.random.Generator, max_edges: int) -> dict[str, Any] | N
     d["name"] = "fuzz"
     d["features"] = dr.features
     return d
+
+
+def _contact_family(rng: np.random.Generator, dr: _Draft, a: np.ndarray, r: float) -> None:
+    """Obstacles flush on an edge ``p -> q`` of the placed target ``a`` (CCW)."""
+    i = int(rng.integers(len(a)))
+    p, q = a[i], a[(i + 1) % len(a)]
+    e = q - p
+    n = _outward(a, i) * r * rng.uniform(0.3, 1.0)
+    kind = rng.choice(["flush_both_ends", "under_opening", "shared_flush"])
+    if kind == "flush_both_ends":
+        # two boxes flush on the edge, over its ends, the middle exposed
+        s0, s1 = rng.uniform(0.15, 0.4), rng.uniform(0.6, 0.85)
+        over = e * rng.uniform(0.05, 0.3)
+        dr.obstacles.append(np.array([p + e * s0, p - over, p - over + n, p + e * s0 + n]))
+        dr.obstacles.append(np.array([q + over, p + e * s1, p + e * s1 + n, q + over + n]))
+    elif kind == "under_opening":
+        # two boxes beyond the ends of the edge, flush with its line: an opening above it
+        w = e * rng.uniform(0.3, 1.0)
+        g = e * rng.uniform(0.0, 0.2)
+        dr.obstacles.append(np.array([p - g, p - g - w, p - g - w + n, p - g + n]))
+        dr.obstacles.append(np.array([q + g + w, q + g, q + g + n, q + g + w + n]))
+    else:
+        # a box flush on the whole edge and a second one sharing its outer edge
+        dr.obstacles.append(np.array([q, p, p + n, q + n]))
+        dr.obstacles.append(np.array([q + n, p + n, p + 2 * n, q + 2 * n]))
+    dr.features.append(str(kind))
 
 
 def _scaled(v: Any, k: float) -> Any:
@@ -417,10 +470,14 @@ def check_scene(
     translate: bool = True,
     seed: int = 0,
     hang_s: float = HANG_S,
+    frames: bool = False,
 ) -> tuple[list[Finding], dict[str, float]]:
     """Run every query type on the scene dictionary ``d`` (see the module docstring);
     returns the findings and the time of every query (seconds).  ``hang_s``: the
-    time limit of one query (wall clock)."""
+    time limit of one query (wall clock).  ``frames=True`` also maps the scene into
+    the frames of issue 26 (scaled by 1e-3 and 1e3, moved to UTM-size coordinates;
+    neither map is exact in binary) and demands the same regions mapped back
+    (``frame``), and checks the 5.2 region against the stationary recognizable one."""
     d = {k: v for k, v in d.items() if k != "features"}
     s = Scene.from_dict(d)
     rng = np.random.default_rng(seed)
@@ -499,10 +556,36 @@ def check_scene(
             )
             incl(p_in, pv, "translating ⊆ stationary (partial)")
         if poly_gh:
-            run(
+            r52 = run(
                 "recognizable partial 5.2",
                 lambda: recognizable_region(s, model="partial", theta=theta, conservative=True),
             )
+            # by definition a recognizable placement sees A wherever it is in G and in H
+            p_h = _timed(
+                lambda: partial_region(s, target_in="failure", theta=theta),
+                "partial in H",
+                out,
+                {},
+            )
+            p_g = _timed(
+                lambda: partial_region(s, target_in="goal", theta=theta), "partial in G", out, {}
+            )
+            incl(r52, p_g, "recognizable 5.2 ⊆ R(G)")
+            incl(r52, p_h, "recognizable 5.2 ⊆ R(H)")
+            if frames and r52 is not None and theta == 0.0:
+                # ... and it is recognizable for every pose pair: G and H shrunk to one
+                # vertex each gives the stationary recognizable region (issue 25 item 3)
+                try:
+                    st = s.replace(goal=s.goal[:1].tolist(), failure=s.failure[:1].tolist())
+                except SceneError:
+                    st = None
+                if st is not None:
+                    rs = _timed(
+                        lambda: recognizable_region(st, model="partial"), "recog at g, h", out, {}
+                    )
+                    incl(r52, rs, "recognizable 5.2 ⊆ stationary recognizable")
+    if frames:
+        _check_frames(s, d, q_at, theta, out)
     if translate:
         k = int(rng.integers(1, 6))
         unit = math.ldexp(1.0, math.ceil(math.log2(D)))
@@ -531,13 +614,85 @@ def check_scene(
     return out, times
 
 
+#: The frames of :func:`_check_frames`: ``world = k * scene + (ox, oy)`` (for ``utm`` the
+#: scene is first scaled by a power of two to a diameter of about 10).
+FRAMES = {
+    "scale1e-3": (1e-3, 0.0, 0.0),
+    "scale1e3": (1e3, 0.0, 0.0),
+    "utm": (1.0, 512345.0, 5412345.0),
+}
+
+
+def _mapped(d: dict, k: float, ox: float, oy: float) -> dict:
+    out = dict(d)
+
+    def f(pts: list) -> list:
+        return [[k * x + ox, k * y + oy] for x, y in pts]
+
+    for key in ("bounds", "goal", "failure"):
+        out[key] = f(d[key])
+    out["obstacles"] = [f(o) for o in d["obstacles"]]
+    out["target"] = [[k * x, k * y] for x, y in d["target"]]
+    if d.get("sensor"):
+        sen = dict(d["sensor"])
+        for key in ("range_acc", "max_range", "eps_pos"):
+            if sen.get(key) is not None:
+                sen[key] = sen[key] * k
+        out["sensor"] = sen
+    return out
+
+
+def _check_frames(
+    s: Scene, d: dict, q_at: tuple[float, float, float], theta: float, out: list[Finding]
+) -> None:
+    """Issue 26 item 9: the regions of the scene mapped into another frame (inexactly:
+    the inputs differ by rounding, ~1e-10 D), mapped back, equal the originals to
+    1e-7 D^2 (findings ``frame``)."""
+    D = s.diameter
+    for fname, (k, ox, oy) in FRAMES.items():
+        if fname == "utm":
+            # a room of about 10 m first (an exact power-of-two scale): a 1e-6 m scene at
+            # 5e6 m has no digits left, which is not the question
+            k = math.ldexp(1.0, round(math.log2(10.0 / D)))
+        try:
+            t = Scene.from_dict(_mapped(d, k, ox, oy))
+        except SceneError as e:
+            out.append(Finding("frame", f"validation ({fname})", str(e)))
+            continue
+        qx, qy = q_at[0] * k + ox, q_at[1] * k + oy
+        for name, fn in (
+            ("complete at", lambda sc, x, y: complete_region(sc, target_at=(x, y, theta))),
+            ("partial at", lambda sc, x, y: partial_region(sc, target_at=(x, y, theta))),
+            ("complete in", lambda sc, x, y: complete_region(sc, target_in="goal", theta=theta)),
+        ):
+            try:
+                a = fn(s, q_at[0], q_at[1])
+                b = fn(t, qx, qy)
+            except (SceneError, NotImplementedError):
+                continue
+            except Exception as e:  # noqa: BLE001
+                out.append(Finding("crash", f"{name} ({fname})", f"{type(e).__name__}: {e}"))
+                continue
+            back = shapely.transform(b, lambda c, k=k, ox=ox, oy=oy: (c - [ox, oy]) / k)
+            diff = shapely.symmetric_difference(a, back).area
+            if diff > 1e-7 * D * D:
+                out.append(Finding("frame", f"{name} ({fname})", f"{diff / D**2:.3g} D^2"))
+
+
 # ---------------------------------------------------------------------------------------------
 # command line
 # ---------------------------------------------------------------------------------------------
 
 
 def run_many(
-    n: int, *, seed: int = 0, swept: bool = False, max_edges: int = 60, verbose: bool = False
+    n: int,
+    *,
+    seed: int = 0,
+    swept: bool = False,
+    max_edges: int = 60,
+    verbose: bool = False,
+    contacts: bool = False,
+    frames: bool = False,
 ) -> dict[str, Any]:
     """Fuzz ``n`` scenes (seeds ``seed .. seed + n - 1``); returns a summary dictionary."""
     kinds: Counter[str] = Counter()
@@ -546,11 +701,11 @@ def run_many(
     n_valid = 0
     t0 = time.perf_counter()
     for i in range(seed, seed + n):
-        d = fuzz_scene(i, max_edges=max_edges)
+        d = fuzz_scene(i, max_edges=max_edges, contacts=contacts)
         if d is None:
             continue
         n_valid += 1
-        found, times = check_scene(d, swept=swept, seed=i)
+        found, times = check_scene(d, swept=swept, seed=i, frames=frames)
         for k, v in times.items():
             slowest[k] = max(slowest.get(k, 0.0), v)
         for f in found:
@@ -579,15 +734,29 @@ def main(argv: list[str] | None = None) -> int:
         "--swept", action="store_true", help="also the swept (target_in) partial queries"
     )
     ap.add_argument("--max-edges", type=int, default=60)
+    ap.add_argument(
+        "--contacts", action="store_true", help="the contact families of issue 26 in the scenes"
+    )
+    ap.add_argument(
+        "--frames", action="store_true", help="also scaled (1e-3, 1e3) and UTM frames (issue 26)"
+    )
     ap.add_argument("--json", help="write the summary (with failing seeds) to this file")
     ap.add_argument("-v", "--verbose", action="store_true")
     a = ap.parse_args(argv)
-    res = run_many(a.n, seed=a.seed, swept=a.swept, max_edges=a.max_edges, verbose=a.verbose)
+    res = run_many(
+        a.n,
+        seed=a.seed,
+        swept=a.swept,
+        max_edges=a.max_edges,
+        verbose=a.verbose,
+        contacts=a.contacts,
+        frames=a.frames,
+    )
     if a.json:
         with open(a.json, "w", encoding="utf-8") as f:
             json.dump(res, f, indent=1)
     print(f"seeds {a.seed}..{a.seed + a.n - 1}: {res['valid']} valid scenes, {res['seconds']} s")
-    for k in ("crash", "invalid", "outside", "inclusion", "unsafe", "translation", "hang"):
+    for k in ("crash", "invalid", "outside", "inclusion", "unsafe", "translation", "frame", "hang"):
         print(f"  {k:12s} {res['violations'].get(k, 0)}")
     print("  slowest query (s):", res["slowest_query_s"])
     return 1 if res["violations"] else 0

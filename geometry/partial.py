@@ -42,7 +42,7 @@ from ._common import (
     target_spec,
 )
 from ._frame import world_messages
-from ._shapes import ccw_ring, disc_sum
+from ._shapes import ccw_ring, disc_sum, snapped
 from .sweep import swept_shadows
 from .weak import ENV, UNWANTED, WANTED, weak_visibility  # noqa: F401 (re-exported)
 
@@ -166,8 +166,10 @@ def _partial_region(
     # clipped to the free space: an anchor on a target edge that lies flush against an
     # obstacle (touching within the scene's tolerance) may be inside that obstacle by
     # rounding, and its fan then fills the obstacle (issue 10, fuzz seed 223)
-    allowed = shapely.difference(scene.free_space, spec.area)
-    region = polygonal(shapely.intersection(region, allowed))
+    g = scene.snap  # snap-rounding overlays: exact contacts (docs/DESIGN.md, "Contacts")
+    allowed = snapped(shapely.difference, scene.free_space, spec.area, g)
+    # (snap-rounding overlays take one dimension: the areal parts of the fans' union)
+    region = polygonal(snapped(shapely.intersection, region, allowed, g))
     if eps_pos > 0:
         region = shrink_for_position(region, allowed, eps_pos)
     return region
@@ -207,6 +209,7 @@ def _swept_region(
     if conservative:
         # tol: the traced arcs' chords; grid: the snap-rounding of the union (sweep.py)
         shadows = disc_sum(shadows, tol + stats["grid"])
+    # floating overlay: the shadows are already snap-rounded on the sweep's own grid
     allowed = shapely.difference(scene.free_space, spec.area)
     out = polygonal(shapely.difference(allowed, shadows))
     if eps_pos > 0:

@@ -42,7 +42,7 @@ from ._common import (
     target_spec,
 )
 from ._frame import world_messages
-from ._shapes import ccw_ring
+from ._shapes import ccw_ring, snapped, union_all
 from .complete import complete_region
 from .partial import ROTATING_PARTIAL, _swept_region, swept_tol
 from .weak import weak_visibility
@@ -159,7 +159,8 @@ def _recognizable_region(
         ring_cw, wanted_cw = ring[::-1], np.roll(wanted[::-1], -1)
         reg = weak_visibility(scene_domain(scene), ring_cw, wanted_cw, eps_aim)
         # clipped to the free space (see partial._partial_region)
-        reg = polygonal(shapely.intersection(reg, shapely.difference(scene.free_space, spec.area)))
+        allowed = snapped(shapely.difference, scene.free_space, spec.area, scene.snap)
+        reg = polygonal(snapped(shapely.intersection, reg, allowed, scene.snap))
         if eps_pos > 0:
             reg = shrink_for_position(reg, shapely.difference(scene.free_space, spec.area), eps_pos)
         regions.append(reg)
@@ -230,7 +231,7 @@ def overlap_strips(
             a, b = target[j], target[(j + 1) % len(target)]
             pts = np.concatenate([tri + a, tri + b], axis=1)  # (T, 6, 2)
             parts.append(shapely.convex_hull(shapely.multipoints(pts)))
-        strip = shapely.union_all(np.concatenate(parts))
+        strip = union_all(np.concatenate(parts))
         if rho > 0:
             strip = shapely.buffer(strip, rho, join_style="mitre", mitre_limit=2.0)
         out.append(strip)

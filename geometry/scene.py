@@ -54,7 +54,7 @@ from shapely.geometry import MultiPolygon, Point, Polygon
 from shapely.geometry.base import BaseGeometry
 
 from ._frame import IDENTITY, Frame, frame_params, to_world_point, world_messages
-from ._shapes import areal
+from ._shapes import areal, snap_grid
 
 __all__ = ["SceneError", "SensorSpec", "Scene", "TOL_REL", "PAPER_ASSUMPTION"]
 
@@ -73,6 +73,10 @@ ALLOWED_KEYS = REQUIRED_KEYS + OPTIONAL_KEYS
 SENSOR_KEYS = ("fov_deg", "max_range", "eps_pos", "eps_aim_deg", "range_acc", "normal_acc_deg")
 #: Sensor fields measured in scene units (scaled with the scene into its local frame).
 _LENGTH_SENSOR_KEYS = ("max_range", "eps_pos", "range_acc")
+#: Largest accepted coordinate magnitude (scene units): the cross products and areas the
+#: region algorithms form must stay finite (1e300 coordinates used to be reported as a
+#: "zero-area polygon", issue 26 item 10).
+MAX_COORD = 1e100
 #: Default range accuracy relative to the scene's diameter (``range_acc: null``).
 RANGE_ACC_REL = 1e-6
 #: Default normal accuracy in degrees.
@@ -164,6 +168,11 @@ def _parse_points(value: Any, where: str, *, allow_point: bool = False) -> np.nd
                 raise SceneError(f"{where}[{i}]: coordinates must be numbers, got {_short(c)}")
             if not math.isfinite(c):
                 raise SceneError(f"{where}[{i}]: non-finite coordinate {c!r}")
+            if abs(c) > MAX_COORD:
+                raise SceneError(
+                    f"{where}[{i}]: coordinate {c!r} is beyond +-{MAX_COORD:g}: products of "
+                    "such coordinates (areas, cross products) overflow double precision"
+                )
         pts.append((float(v[0]), float(v[1])))
     n = len(pts)
     if allow_point and n == 1:
@@ -205,6 +214,25 @@ def _parse_points(value: Any, where: str, *, allow_point: bool = False) -> np.nd
     if area < 0:
         a = a[::-1].copy()
     return _readonly(a)
+
+
+def _merge_near(a: np.ndarray, where: str, tol: float) -> np.ndarray:
+    """The CCW ring ``a`` with every vertex closer than ``tol`` (``TOL_REL`` times the
+    scene's diameter) to the previous kept vertex dropped (docs/DESIGN.md, "Contacts"): two target
+    vertices 1e-9 D apart made an edge whose direction is rounding noise, and the region
+    algorithms took it for a real edge (issue 26 item 1).  Raises ``SceneError`` when
+    fewer than 3 vertices remain."""
+    keep = [0]
+    for i in range(1, len(a)):
+        if np.abs(a[i] - a[keep[-1]]).max() > tol:
+            keep.append(i)
+    while len(keep) > 1 and np.abs(a[keep[-1]] - a[keep[0]]).max() <= tol:
+        keep.pop()
+    if len(keep) == len(a):
+        return a
+    if len(keep) < 3:
+        raise SceneError(f"{where}: fewer than 3 vertices more than {tol:.3g} apart")
+    return _readonly(a[keep].copy())
 
 
 # ---------------------------------------------------------------------------------------------
@@ -470,7 +498,8 @@ class Scene:
         if not isinstance(obs_in, list):
             raise SceneError(f"obstacles: expected a list of polygons, got {_short(obs_in)}")
         obstacles = tuple(_parse_points(o, f"obstacles[{i}]") for i, o in enumerate(obs_in))
-        target = _parse_points(d["target"], "target")
+        diam = float(np.hypot(*np.ptp(bounds, axis=0)))
+        target = _merge_near(_parse_points(d["target"], "target"), "target", TOL_REL * diam)
         goal = _parse_points(d["goal"], "goal", allow_point=True)
         failure = _parse_points(d["failure"], "failure", allow_point=True)
         sensor = SensorSpec.from_dict(d.get("sensor"))
@@ -557,13 +586,15 @@ class Scene:
                 f"{which}: CH(A ⊕ {sym}) (convex hull of the target's swept area at orientation 0)",
             )
         if self.start is not None:
-            p = Point(self.start[0], self.start[1])
-            v = self._violation(p if ref_inside else self.target_at(*self.start))
+            # ``start`` is the sensor robot's pose, not the target's: its point must lie in
+            # the free space whatever the target's shape or reference point (issue 25 item
+            # 5: the target's footprint was placed there and valid scenes were rejected).
+            # The scene does not know the robot's footprint; callers that do check it.
+            v = self._violation(Point(self.start[0], self.start[1]))
             if v is not None:
-                what = "" if ref_inside else " (the target placed there)"
                 raise SceneError(
-                    f"start: {_fmt_pt(self.start[0], self.start[1])}{what} is not in the free "
-                    f"space (bounds minus obstacles): meets {v[0]}"
+                    f"start: {_fmt_pt(self.start[0], self.start[1])} is not in the free space "
+                    f"(bounds minus obstacles): meets {v[0]} (start is the sensor robot's pose)"
                 )
 
     # -- read-only-ness, equality, pickling ------------------------------------------------------
@@ -672,10 +703,29 @@ class Scene:
 
     @functools.cached_property
     def free_space(self) -> Polygon | MultiPolygon:
-        """Bounds minus the obstacle union (a Polygon, or a MultiPolygon if disconnected)."""
+        """Bounds minus the obstacle union (a Polygon, or a MultiPolygon if disconnected).
+
+        GEOS's floating overlay can keep a sliver obstacle flush on a wall as free space
+        (it judged the obstacle both inside and outside the bounds, issue 26 item 7); when
+        an obstacle's interior point is in the floating result, the snap-rounding overlay
+        on the grid :attr:`snap` is used instead (docs/DESIGN.md, "Contacts")."""
         if self.obstacle_union.is_empty:
             return self.bounds_geom
-        return _polygonal(self.bounds_geom.difference(self.obstacle_union))
+        fs = _polygonal(self.bounds_geom.difference(self.obstacle_union))
+        inner = np.array([o.representative_point().coords[0] for o in self.obstacle_geoms])
+        if fs.is_valid and not shapely.contains_xy(fs, inner[:, 0], inner[:, 1]).any():
+            return fs
+        return _polygonal(
+            shapely.difference(self.bounds_geom, self.obstacle_union, grid_size=self.snap)
+        )
+
+    @functools.cached_property
+    def snap(self) -> float:
+        """Grid of the snap-rounded overlays that build :attr:`obstacle_union` and
+        :attr:`free_space` (``SNAP_REL = 1e-13`` of the diameter; docs/DESIGN.md, "Contacts").
+        GEOS's floating overlay can put a flush sliver obstacle both inside and outside
+        a wall at once (issue 26 item 7); the snap-rounding overlay cannot."""
+        return snap_grid(self.bounds)
 
     @functools.cached_property
     def goal_geom(self) -> Polygon | Point:

@@ -57,7 +57,7 @@ from shapely import affinity
 from . import _libm
 from . import visindex as _visindex
 from ._common import polygonal
-from ._shapes import areal
+from ._shapes import areal, union_all
 from ._shapes import cross as _cross
 from ._vis import TAU, Domain, RayEscapeError, gaps_many
 from .weak import ENV as _ENV
@@ -602,7 +602,7 @@ class Sweeper:
         e = np.roll(r, -1, axis=0)
         d = qb - qa
         par = shapely.polygons(np.stack([r, e, e + d, r + d], axis=1))
-        core = polygonal(shapely.difference(core, shapely.union_all(par)))
+        core = polygonal(shapely.difference(core, union_all(par)))
         if core.is_empty:
             return None
         parts = shapely.get_parts(core)

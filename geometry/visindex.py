@@ -580,6 +580,8 @@ def sorted_gaps(
     Either way the directions kept -- hence the gaps -- are exactly the full loop's."""
     q = np.ascontiguousarray(q, dtype=np.float64)
     n = len(q)
+    if n == 0:  # no viewpoints (e.g. every candidate dropped): no gaps (issue 25 item 7)
+        return np.zeros(0, dtype=np.int64), np.zeros(0), np.zeros(0)
     start = np.ascontiguousarray(start, dtype=np.float64)
     width = np.ascontiguousarray(width, dtype=np.float64)
     vert = np.ascontiguousarray(vert, dtype=np.float64)

@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 import shapely
 
+from ._shapes import union_all
 from ._vis import TAU, Domain, Gaps, clean_polygon, gaps_many
 
 __all__ = ["ENV", "UNWANTED", "WANTED", "weak_visibility"]
@@ -93,14 +94,14 @@ def weak_visibility(
 def _union(polys: list[shapely.Geometry], n_first: int) -> shapely.Geometry:
     """Union of polygons; the later ones are first tested (vectorised) against the
     union of the first ``n_first`` and dropped when already covered by it."""
-    first = shapely.union_all(polys[:n_first]) if n_first else shapely.Polygon()
+    first = union_all(polys[:n_first]) if n_first else shapely.Polygon()
     rest = np.asarray(polys[n_first:], dtype=object)
     if len(rest) and not first.is_empty:
         shapely.prepare(first)
         rest = rest[~shapely.covers(first, rest)]
     if len(rest) == 0:
         return first
-    return shapely.union_all(np.concatenate([[first], rest]))
+    return union_all(np.concatenate([[first], rest]))
 
 
 def _runs(g: Gaps, mask: np.ndarray) -> list[np.ndarray]:

@@ -285,6 +285,48 @@ def test_eps_pos_larger_than_room():
         partial_region(s, target_at=(2, 1.5, 0), eps_pos=1e9)
 
 
+def test_inputs_issue26_item10():
+    """Issue 26 item 10 (and 25 item 6): strings are not numbers, degrees are not radians,
+    huge coordinates are named as such, and query-time errors name world coordinates."""
+    s = Scene.from_dict(ROOM)
+    for kw in ({"eps_pos": "0.1"}, {"eps_aim": "0.1"}, {"eps_pos": True}):
+        with pytest.raises(ValueError, match=r"must be a number, got"):
+            partial_region(s, target_at=(2, 1.5, 0), **kw)
+    with pytest.raises(ValueError, match="eps_pos must be a number"):
+        complete_region(s, target_at=(2, 1.5, 0), eps_pos="0.1")
+    # theta = 90 (degrees by mistake) is rejected like the JSON start's theta
+    for f in (
+        lambda: complete_region(s, target_at=(2, 1.5, 90)),
+        lambda: partial_region(s, target_at=(2, 1.5, 90.0)),
+        lambda: complete_region(s, target_in="goal", theta=90),
+        lambda: partial_region(s, target_in="goal", theta=-90.0),
+        lambda: recognizable_region(s, theta=90),
+    ):
+        with pytest.raises(ValueError, match=r"radians \(did you mean -?90(\.0)? degrees"):
+            f()
+    assert complete_region(s, target_at=(2, 1.5, 2 * math.pi - 1e-9)).area > 0
+    with pytest.raises(SceneError, match=r"bounds\[0\]: coordinate 1e\+300 is beyond"):
+        Scene.from_dict(shifted(ROOM, 1e300, 0.0))
+    # a query-time error names the user's coordinates, not the local frame's
+    d = shifted(ROOM, 512345.0, 5412345.0)
+    far = Scene.from_dict(d)
+    with pytest.raises(SceneError, match=r"target at \(512349, 5\.41235e\+06, 0\).*meets"):
+        complete_region(far, target_at=(512345.0 + 4.2, 5412345.0 + 4.0, 0.0))
+
+
+def test_start_is_the_robots_pose_issue25_item5():
+    """The robot's start is validated as a point, never as the target placed there."""
+    d = copy.deepcopy(ROOM)
+    d["target"] = [[1.0, 1.0], [2.0, 1.0], [2.0, 2.0]]  # reference point outside the target
+    d["goal"], d["failure"] = [[1.0, 1.0]], [[6.5, 5.0]]
+    d["start"] = [3.2, 2.5, 0.0]  # free, but the target placed there would meet the obstacle
+    s = Scene.from_dict(d)
+    assert s.start == (3.2, 2.5, 0.0)
+    d["start"] = [5.0, 4.0, 0.0]
+    with pytest.raises(SceneError, match=r"start: \(5, 4\) is not in the free space"):
+        Scene.from_dict(d)
+
+
 # -- sensor accuracy in confusability ---------------------------------------------------------
 
 RECT = [[-1, -0.5], [1, -0.5], [1, 0.5], [-1, 0.5]]
