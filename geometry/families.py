@@ -30,7 +30,6 @@ CH(G (+) disc(r)) and CH(H (+) disc(r)), r the target's radius), as
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -114,30 +113,31 @@ class SceneFamily:
     max_tries: int = 100
 
     def __post_init__(self) -> None:
-        _range("fov_deg", self.fov_deg, 1e-9, 360.0)
+        def bad(name: str, need: str) -> ValueError:
+            return ValueError(f"SceneFamily.{name} must be {need}, got {getattr(self, name)!r}")
+
+        _range("fov_deg", self.fov_deg, 0.0, 360.0)
         if self.fov_deg[0] <= 0:
-            raise ValueError(f"SceneFamily.fov_deg must be > 0, got {self.fov_deg!r}")
+            raise bad("fov_deg", "> 0")
         if self.max_range is not None:
             _range("max_range", self.max_range, 1e-9, 10.0)
         if not 0.0 <= float(self.range_limited) <= 1.0:
-            raise ValueError(f"SceneFamily.range_limited must be in [0, 1], got {self.range_limited!r}")
+            raise bad("range_limited", "in [0, 1]")
         if self.range_limited > 0 and self.max_range is None:
-            raise ValueError("SceneFamily.range_limited > 0 needs a max_range range")
-        bad = [s for s in self.shapes if s not in ROOM_SHAPES]
-        if not self.shapes or bad:
-            raise ValueError(f"SceneFamily.shapes must be a non-empty subset of {ROOM_SHAPES}, got {self.shapes!r}")
+            raise bad("max_range", "a (low, high) pair when range_limited > 0")
+        if not self.shapes or any(s not in ROOM_SHAPES for s in self.shapes):
+            raise bad("shapes", f"a non-empty subset of {ROOM_SHAPES}")
         _range("clutter", self.clutter, 0.0, 0.6)
-        bad = [k for k in self.region_kinds if k not in REGION_KINDS]
-        if not self.region_kinds or bad:
-            raise ValueError(f"SceneFamily.region_kinds must be a non-empty subset of {REGION_KINDS}, got {self.region_kinds!r}")
+        if not self.region_kinds or any(k not in REGION_KINDS for k in self.region_kinds):
+            raise bad("region_kinds", f"a non-empty subset of {REGION_KINDS}")
         if not self.target_convex or any(not isinstance(c, bool) for c in self.target_convex):
-            raise ValueError(f"SceneFamily.target_convex must be a non-empty tuple of bools, got {self.target_convex!r}")
+            raise bad("target_convex", "a non-empty tuple of bools")
         lo, hi = _range("target_vertices", self.target_vertices, 3, 64)
         if False in self.target_convex and hi < 4:
-            raise ValueError("a non-convex target needs target_vertices to reach 4 or more")
+            raise bad("target_vertices", "able to reach 4 for a non-convex target")
         _range("diameter", self.diameter, 4.0, 1e6)
         if not isinstance(self.max_tries, int) or self.max_tries < 1:
-            raise ValueError(f"SceneFamily.max_tries must be a positive integer, got {self.max_tries!r}")
+            raise bad("max_tries", "a positive integer")
 
     # ---- sampling ---------------------------------------------------------------------
     def sample_dict(self, rng: np.random.Generator) -> dict[str, Any]:
@@ -181,7 +181,9 @@ class SceneFamily:
             if self.range_limited >= 1.0:
                 out.append("max_range=None but the family's sensors are always range-limited")
         elif self.max_range is None or self.range_limited == 0:
-            out.append(f"max_range_rel={params['max_range_rel']:.6g} but the family has no range limit")
+            out.append(
+                f"max_range_rel={params['max_range_rel']:.6g}: the family has no range limit"
+            )
         else:
             rng_ok("max_range_rel", *self.max_range)
         if params["room_shape"] not in self.shapes:
@@ -250,7 +252,7 @@ def get_family(family: str | SceneFamily) -> SceneFamily:
         return family
     if isinstance(family, str) and family in FAMILIES:
         return FAMILIES[family]
-    raise ValueError(f"unknown scene family {family!r}: use one of {sorted(FAMILIES)} or a SceneFamily")
+    raise ValueError(f"unknown scene family {family!r}: use {sorted(FAMILIES)} or a SceneFamily")
 
 
 def get_difficulty(name: str) -> Difficulty:
@@ -489,4 +491,3 @@ def _try_family(fam: SceneFamily, rng: np.random.Generator) -> tuple[dict | None
         "sensor": sensor,
     }
     return d, ""
-

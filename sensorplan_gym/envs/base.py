@@ -22,9 +22,15 @@ scene : str | path | dict | geometry.Scene, default ``"lab"``
     from the start, or that contain the start are re-drawn when the pool is built).
 scene_pool_size : int, default 64 -- scenes in the ``"random"`` pool.
 scene_pool_seed : int, default 0 -- the pool's seed (disjoint seeds: disjoint splits).
-min_start_distance : float, default 0 -- a difficulty knob for ``scene="random"``: pool
-    scenes whose start lies closer than this fraction of the scene diameter to the
-    recognizable region are re-drawn (Navigate, Recognize).
+min_start_distance : float | None, default None (0, or the ``difficulty``'s) -- a difficulty
+    knob for ``scene="random"``: pool scenes whose start lies closer than this fraction of the
+    scene diameter to the recognizable region are re-drawn (Navigate, Recognize).
+family : str | geometry.families.SceneFamily | None -- with ``scene="random"``, draw the pool
+    from this scene family (``"easy"``, ``"medium"``, ``"hard"`` or a ``SceneFamily``) instead
+    of :func:`geometry.generate.random_scene` (the default, unchanged).
+difficulty : ``"easy"`` | ``"medium"`` | ``"hard"`` | None -- with ``scene="random"``, a
+    benchmark level (:data:`geometry.families.DIFFICULTIES`): its family and its
+    ``min_start_distance`` (an explicit ``min_start_distance`` wins).
 model : ``"complete"`` | ``"partial"`` -- the visibility model of the recognizable region.
 motion : ``"stationary"`` | ``"translating"`` | ``"rotating"`` (see
     :mod:`sensorplan_gym.core.world`).  Unsupported combinations raise
@@ -72,6 +78,8 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 import shapely
+
+from geometry.families import SceneFamily, get_difficulty, get_family
 
 from ..core import fused
 from ..core.actions import make_actions
@@ -169,6 +177,35 @@ def _check(
     return start, problem
 
 
+def _resolve_family(
+    random: bool,
+    family: str | SceneFamily | None,
+    difficulty: str | None,
+    min_start_distance: float | None,
+    random_scene_kwargs: dict | None,
+) -> tuple[SceneFamily | None, float | None]:
+    """``(scene family or None, min_start_distance)`` from the envs' ``family`` /
+    ``difficulty`` / ``min_start_distance`` kwargs (an explicit ``min_start_distance`` wins
+    over the difficulty's; ``None`` stays ``None`` without a difficulty)."""
+    if family is None and difficulty is None:
+        return None, min_start_distance
+    if not random:
+        raise ValueError("family= and difficulty= need scene='random'")
+    if random_scene_kwargs:
+        raise ValueError("give random_scene_kwargs or family=/difficulty=, not both")
+    if difficulty is not None:
+        level = get_difficulty(difficulty)
+        if family is not None and get_family(family) != level.family:
+            raise ValueError(
+                f"difficulty={difficulty!r} has its own family ({level.family.name!r}); "
+                f"drop family={family!r} or the difficulty"
+            )
+        if min_start_distance is None:
+            min_start_distance = level.min_start_distance
+        return level.family, min_start_distance
+    return get_family(family), min_start_distance
+
+
 class SensorPlanBatch(BatchSim):
     """A task over N sub-environments; subclasses define ``obs_kind``, ``action_dim`` and the
     hooks ``_reset_one`` (Python, per resetting sub-environment: draws from its generator),
@@ -198,7 +235,9 @@ class SensorPlanBatch(BatchSim):
         robot_radius: float = 0.0,
         random_scene_kwargs: dict | None = None,
         max_scene_tries: int = 25,
-        min_start_distance: float = 0.0,
+        min_start_distance: float | None = None,
+        family: str | SceneFamily | None = None,
+        difficulty: str | None = None,
         scene_pool_size: int = 64,
         scene_pool_seed: int = 0,
         max_steps: int | None = None,
@@ -266,6 +305,11 @@ class SensorPlanBatch(BatchSim):
         self.action_type = action_type
         self.single_action_space = self.actions.space
         self.random = isinstance(scene, str) and scene == "random"
+        family, min_start_distance = _resolve_family(
+            self.random, family, difficulty, min_start_distance, random_scene_kwargs
+        )
+        if min_start_distance is None:
+            min_start_distance = 0.0
         if not isinstance(min_start_distance, (int, float)) or not 0 <= min_start_distance < 1:
             raise ValueError(f"min_start_distance must be in [0, 1), got {min_start_distance!r}")
         self.min_start_distance = float(min_start_distance)
@@ -280,6 +324,7 @@ class SensorPlanBatch(BatchSim):
                 seed=scene_pool_seed,
                 scene_kwargs=dict(random_scene_kwargs or {}),
                 max_tries=max_scene_tries,
+                family=family,
             )
             world, start = self.source.get(0)  # unsupported configurations fail here
         else:
