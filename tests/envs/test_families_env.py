@@ -1,0 +1,104 @@
+"""``scene="random"`` with ``family=`` / ``difficulty=``: pools drawn from scene families,
+the oracle solving them, seeding, and the unchanged default generator."""
+
+from __future__ import annotations
+
+import time
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import sensorplan_gym  # noqa: F401  (registers the envs)
+from agents.planning.oracle import OraclePolicy
+from geometry.families import DIFFICULTIES, FAMILIES, HARD, scene_parameters
+from geometry.generate import random_scene
+
+NAV = "sensorplan/Navigate-v0"
+
+
+def rollout(env, policy, seed: int) -> dict:
+    obs, info = env.reset(seed=seed)
+    start, done = True, False
+    while not done:
+        action, _ = policy.predict(obs, episode_start=start)
+        start = False
+        obs, _, term, trunc, info = env.step(action)
+        done = term or trunc
+    return info
+
+
+def test_oracle_solves_navigate_in_every_difficulty():
+    t0 = time.perf_counter()
+    for name, level in DIFFICULTIES.items():
+        env = gym.make(NAV, scene="random", difficulty=name, scene_pool_size=4)
+        batch = env.unwrapped.batch
+        assert batch.source.family is level.family
+        assert batch.min_start_distance == level.min_start_distance
+        policy = OraclePolicy(env)
+        for seed in range(4):
+            info = rollout(env, policy, seed)
+            assert info["is_success"], (name, seed)
+            assert level.family.contains(scene_parameters(env.unwrapped.world.scene))
+    assert time.perf_counter() - t0 < 60
+
+
+def test_pool_scenes_lie_in_the_family_and_far_enough():
+    env = gym.make(NAV, scene="random", difficulty="hard", scene_pool_size=6)
+    pool = env.unwrapped.batch.source.build()
+    for k in range(pool.size):
+        world, start = pool.get(k)
+        assert HARD.contains(scene_parameters(world.scene)), k
+        assert world.distance_to_region(*start[:2]) >= 0.35 * world.diameter
+
+
+def test_seeding_is_deterministic():
+    def trace(seed: int) -> list[np.ndarray]:
+        env = gym.make(NAV, scene="random", family="medium", scene_pool_size=5)
+        out = []
+        for s in range(3):
+            obs, _ = env.reset(seed=seed + s)
+            env.action_space.seed(seed + s)
+            out.append(obs)
+            for _ in range(3):
+                out.append(env.step(env.action_space.sample())[0])
+        return out
+
+    a, b = trace(0), trace(0)
+    assert all(np.array_equal(x, y) for x, y in zip(a, b, strict=True))
+    assert not all(np.array_equal(x, y) for x, y in zip(a, trace(10), strict=True))
+
+
+def test_explicit_min_start_distance_wins_and_family_alone_keeps_zero():
+    env = gym.make(
+        NAV, scene="random", difficulty="hard", min_start_distance=0.1, scene_pool_size=2
+    )
+    assert env.unwrapped.batch.min_start_distance == 0.1
+    env = gym.make(NAV, scene="random", family=FAMILIES["easy"], scene_pool_size=2)
+    assert env.unwrapped.batch.min_start_distance == 0.0
+
+
+def test_default_random_pool_is_todays_generator():
+    env = gym.make(NAV, scene="random", scene_pool_size=2)
+    pool = env.unwrapped.batch.source
+    assert pool.family is None
+    world, _ = pool.get(0)
+    # scene 0 is the first draw of random_scene from [seed, 0] that hosts an episode
+    rng = np.random.default_rng([0, 0])
+    drawn = [random_scene(rng) for _ in range(pool.max_tries)]
+    assert world.scene.to_dict() in drawn
+
+
+@pytest.mark.parametrize(
+    "kw, match",
+    [
+        (dict(scene="lab", family="easy"), "need scene='random'"),
+        (dict(scene="random", family="easy", random_scene_kwargs={"notches": 0}), "not both"),
+        (dict(scene="random", family="huge"), "unknown scene family 'huge'"),
+        (dict(scene="random", difficulty="insane"), "unknown difficulty 'insane'"),
+        (dict(scene="random", difficulty="easy", family="hard"), "has its own family"),
+    ],
+)
+def test_bad_family_kwargs_fail_clearly(kw, match):
+    with pytest.raises(ValueError, match=match):
+        gym.make(NAV, **kw)
