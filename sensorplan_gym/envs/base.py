@@ -55,6 +55,9 @@ map_evidence : bool, default False -- per beam, whether it read shorter than the
     the map; vector observations of Navigate/Recognize).
 sensor_fov : bool, default False -- Navigate/Recognize vector observations end with the
     sensor's field of view / 360 degrees (for scenes whose field of view varies).
+self_features : bool, default False -- Navigate/Recognize vector observations end with what
+    the robot knows of its own sensor: field of view / 360 degrees and reach (maximum range,
+    at most the diameter) / scene diameter (for scene families whose sensors differ).
 max_steps : int | None -- the time limit (default 200; Placement: 1).
 random_scene_kwargs : dict | None -- passed to ``random_scene`` when ``scene="random"``.
 render_mode : ``None`` | ``"rgb_array"`` | ``"human"``.
@@ -245,6 +248,7 @@ class SensorPlanBatch(BatchSim):
         map_ranges: bool = False,
         map_evidence: bool = False,
         sensor_fov: bool = False,
+        self_features: bool = False,
         **action_kw: Any,
     ) -> None:
         for name, v in (
@@ -281,6 +285,7 @@ class SensorPlanBatch(BatchSim):
             ("map_ranges", map_ranges),
             ("map_evidence", map_evidence),
             ("sensor_fov", sensor_fov),
+            ("self_features", self_features),
         ):
             if not isinstance(v, bool):
                 raise ValueError(f"{name} must be True or False, got {v!r}")
@@ -299,6 +304,7 @@ class SensorPlanBatch(BatchSim):
             map_ranges=map_ranges,
             map_evidence=map_evidence,
             sensor_fov=sensor_fov,
+            self_features=self_features,
         )
         self.single_observation_space = self.obs.space
         self.actions = make_actions(action_type, self.action_task, self.action_dim, **action_kw)

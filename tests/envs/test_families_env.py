@@ -11,8 +11,10 @@ import pytest
 
 import sensorplan_gym  # noqa: F401  (registers the envs)
 from agents.planning.oracle import OraclePolicy
-from geometry.families import DIFFICULTIES, FAMILIES, HARD, scene_parameters
+from geometry.families import DIFFICULTIES, FAMILIES, HARD, SceneFamily, scene_parameters
 from geometry.generate import random_scene
+from sensorplan_gym.core import fused
+from tests.envs.test_fused import _episodes
 
 NAV = "sensorplan/Navigate-v0"
 
@@ -102,3 +104,72 @@ def test_default_random_pool_is_todays_generator():
 def test_bad_family_kwargs_fail_clearly(kw, match):
     with pytest.raises(ValueError, match=match):
         gym.make(NAV, **kw)
+
+
+# ---- self_features: what the robot knows about its own sensor ----------------------------
+
+RANGED = SceneFamily(
+    "ranged", fov_deg=(45.0, 200.0), max_range=(0.3, 0.6), range_limited=0.6, shapes=("L",)
+)
+
+
+@pytest.mark.parametrize("env_id", [NAV, "sensorplan/Recognize-v0"])
+def test_self_features_are_the_sensors_fov_and_reach(env_id):
+    kw = dict(scene="random", family=RANGED, scene_pool_size=8)
+    env = gym.make(env_id, self_features=True, **kw)
+    plain = gym.make(env_id, **kw)
+    assert env.observation_space.shape[0] == plain.observation_space.shape[0] + 2
+    ranges = set()
+    for seed in range(16):
+        obs, _ = env.reset(seed=seed)
+        ref, _ = plain.reset(seed=seed)
+        assert env.observation_space.contains(obs)
+        np.testing.assert_array_equal(obs[:-2], ref)
+        scene = env.unwrapped.world.scene
+        mr = scene.sensor.max_range
+        reach = 1.0 if mr is None else min(mr / scene.diameter, 1.0)
+        assert obs[-2] == pytest.approx(scene.sensor.fov_deg / 360.0, rel=1e-6)
+        assert obs[-1] == pytest.approx(reach, rel=1e-6)
+        ranges.add(mr is None)
+    assert ranges == {True, False}  # both limited and unlimited sensors were seen
+    fov_both = gym.make(env_id, self_features=True, sensor_fov=True, **kw)
+    assert fov_both.observation_space.shape[0] == plain.observation_space.shape[0] + 3
+    with pytest.raises(ValueError, match="self_features"):
+        gym.make(env_id, self_features=1)
+    with pytest.raises(ValueError, match="self_features=True needs obs_type='vector'"):
+        gym.make(env_id, self_features=True, obs_type="grid")
+
+
+def test_default_observation_shapes_are_unchanged():
+    for env_id, n in ((NAV, 8 + 3 * 16), ("sensorplan/Recognize-v0", 8 + 3 * 16)):
+        assert gym.make(env_id).observation_space.shape == (n,)
+        assert gym.make(env_id, scene="random", difficulty="hard").observation_space.shape == (n,)
+
+
+def test_self_features_batched_equals_single():
+    kw = dict(scene="random", family=RANGED, scene_pool_size=6, self_features=True, max_steps=25)
+    n = 3
+    venv = gym.make_vec(NAV, num_envs=n, vectorization_mode="vector_entry_point", **kw)
+    singles = [gym.make(NAV, **kw) for _ in range(n)]
+    obs, _ = venv.reset(seed=11)
+    for i, e in enumerate(singles):
+        assert np.array_equal(e.reset(seed=11 + i)[0], obs[i])
+    rng = np.random.default_rng(0)
+    done, episodes = [False] * n, 0
+    for _ in range(120):
+        a = rng.uniform(-1, 1, (n, *venv.single_action_space.shape)).astype(np.float32)
+        obs, rew, term, trunc, _ = venv.step(a)
+        for i, e in enumerate(singles):
+            o = e.reset()[0] if done[i] else e.step(a[i])[0]
+            assert np.array_equal(o, obs[i])
+            done[i] = bool(term[i] or trunc[i])
+            episodes += done[i]
+    assert episodes >= 3 * n  # resets (new scenes, new sensors) were compared too
+
+
+@pytest.mark.skipif(not fused.FUSED, reason="numba not installed (the 'fast' extra)")
+def test_self_features_compiled_equals_numpy_path():
+    kw = dict(scene="random", family=RANGED, scene_pool_size=4, self_features=True)
+    a = _episodes(NAV, 60, True, **kw)
+    b = _episodes(NAV, 60, False, **kw)
+    assert a == b
