@@ -89,6 +89,7 @@ from ..core.actions import make_actions
 from ..core.cache import get_world
 from ..core.observations import make_observation
 from ..core.pool import FixedScene, shared_pool
+from ..core.queries import aim_ok_batch
 from ..core.rendering import HumanViewer, Renderer
 from ..core.sensor import NOISE_BOUND, RangeSensor
 from ..core.sim import BatchSim
@@ -145,7 +146,48 @@ def _sampled_start(world: World, rng: np.random.Generator, tries: int = 10_000) 
     return None
 
 
-def _check(
+def _has_view(
+    world: World, space: shapely.Geometry, rng: np.random.Generator, n: int = 256
+) -> bool:
+    """Whether a pose with its position in ``space`` (a part of the recognizable region) keeps
+    K_G and K_H in the field of view and within range (:meth:`World.aim_ok`), found among
+    ``n`` positions drawn from ``rng`` in ``space`` and seven aims each (the one between the
+    directions to K_G and K_H, and that one turned by +-0.1, 0.2, 0.3 field of view).
+    ``True`` without drawing for a 360-degree sensor of unlimited range.  A sampled test:
+    ``False`` may miss a thin set of such poses (the scene is then re-drawn)."""
+    if world.fov >= 2 * math.pi - 1e-12 and math.isinf(world.max_range):
+        return True
+    if space.is_empty:
+        return False
+    x0, y0, x1, y1 = space.bounds
+    pts = rng.uniform((x0, y0), (x1, y1), (8 * n, 2))
+    pts = pts[shapely.contains_xy(space, pts[:, 0], pts[:, 1])][:n]
+    if len(pts) == 0:
+        return False
+    r = world.batch_rows()
+    c = r["centers"]
+    a = np.arctan2(c[0, 1] - pts[:, 1], c[0, 0] - pts[:, 0])
+    b = np.arctan2(c[1, 1] - pts[:, 1], c[1, 0] - pts[:, 0])
+    mid = a + 0.5 * ((b - a + math.pi) % (2 * math.pi) - math.pi)
+    turns = world.fov * np.array([0.0, -0.1, 0.1, -0.2, 0.2, -0.3, 0.3])
+    psi = (mid[:, None] + turns[None, :]).ravel()
+    xs, ys = np.repeat(pts[:, 0], len(turns)), np.repeat(pts[:, 1], len(turns))
+    m = len(psi)
+    ok = aim_ok_batch(
+        xs,
+        ys,
+        psi,
+        np.broadcast_to(r["hulls"][None], (m, *r["hulls"].shape)),
+        np.broadcast_to(c[None], (m, *c.shape)),
+        fov=world.fov,
+        eps_aim=world.eps_aim,
+        eps_pos=world.eps_pos,
+        max_range=world.max_range,
+    )
+    return bool(ok.any())
+
+
+def _check_pose(
     world: World,
     rng: np.random.Generator,
     needs_start: bool,
@@ -177,6 +219,26 @@ def _check(
         if alt is not None and _scene_problem(world, alt, needs_start) is None:
             return alt, None
         problem += " (and no free start outside the region can reach it)"
+    return start, problem
+
+
+def _check(
+    world: World,
+    rng: np.random.Generator,
+    needs_start: bool,
+    min_start_distance: float = 0.0,
+    fallback_start: bool = False,
+    needs_view: bool = False,
+):
+    """``(start, problem)`` of a world (see :func:`_check_pose`).  With ``needs_view``
+    (scene-family pools of tasks whose success is one recognizing pose), a world where no
+    sampled pose of the (reachable) region keeps G and H in view is a problem too
+    (:func:`_has_view`)."""
+    start, problem = _check_pose(world, rng, needs_start, min_start_distance, fallback_start)
+    if problem is None and needs_view:
+        space = world.reachable_region(start[:2]) if needs_start else world.region
+        if not _has_view(world, space, rng):
+            problem = "no sampled pose of the region keeps G and H in the field of view and range"
     return start, problem
 
 
@@ -219,6 +281,8 @@ class SensorPlanBatch(BatchSim):
     action_dim = 3
     action_task = "robot"
     horizon = 200
+    #: success is one pose that keeps G and H in view (family pools re-draw scenes without one)
+    joint_view = True
 
     def __init__(
         self,
@@ -321,11 +385,15 @@ class SensorPlanBatch(BatchSim):
         self.min_start_distance = float(min_start_distance)
         check = functools.partial(_check, needs_start=self.needs_start)
         if self.random:
-            check = functools.partial(check, min_start_distance=self.min_start_distance)
+            view = family is not None and self.joint_view
+            check = functools.partial(
+                check, min_start_distance=self.min_start_distance, needs_view=view
+            )
             self.source = shared_pool(
                 self.cfg,
                 check,
-                f"start>={self.min_start_distance}" if self.needs_start else "nostart",
+                (f"start>={self.min_start_distance}" if self.needs_start else "nostart")
+                + ("+view" if view else ""),
                 size=scene_pool_size,
                 seed=scene_pool_seed,
                 scene_kwargs=dict(random_scene_kwargs or {}),
