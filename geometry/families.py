@@ -93,7 +93,9 @@ class SceneFamily:
         ``max_range``); 1 means every scene's sensor is range-limited.
     shapes : room shape classes of :data:`ROOM_SHAPES`, drawn uniformly.
     clutter : ``(low, high)`` obstacle area as a fraction of the room's area.
-    region_kinds : kinds of G and H (``"point"``, ``"polygon"``), each drawn uniformly.
+    region_kinds : kinds of G and H (``"point"``, ``"polygon"``), drawn uniformly.
+    mixed_regions : draw G's and H's kinds independently; ``False`` (default): one kind for
+        both (the partial model does not support a point G with a polygonal H yet, issue 25).
     target_convex : allowed target convexities (``True``: convex, ``False``: not).
     target_vertices : ``(low, high)`` inclusive vertex count of the target.
     diameter : ``(low, high)`` scene diameter (bounding-box diagonal, scene units).
@@ -107,6 +109,7 @@ class SceneFamily:
     shapes: tuple[str, ...] = ("rectangle",)
     clutter: tuple[float, float] = (0.0, 0.1)
     region_kinds: tuple[str, ...] = ("point",)
+    mixed_regions: bool = False
     target_convex: tuple[bool, ...] = (True, False)
     target_vertices: tuple[int, int] = (3, 7)
     diameter: tuple[float, float] = (9.0, 16.0)
@@ -136,6 +139,8 @@ class SceneFamily:
         if False in self.target_convex and hi < 4:
             raise bad("target_vertices", "able to reach 4 for a non-convex target")
         _range("diameter", self.diameter, 4.0, 1e6)
+        if not isinstance(self.mixed_regions, bool):
+            raise bad("mixed_regions", "True or False")
         if not isinstance(self.max_tries, int) or self.max_tries < 1:
             raise bad("max_tries", "a positive integer")
 
@@ -192,6 +197,8 @@ class SceneFamily:
         for key in ("goal_kind", "failure_kind"):
             if params[key] not in self.region_kinds:
                 out.append(f"{key}={params[key]!r} not in {self.region_kinds}")
+        if not self.mixed_regions and params["goal_kind"] != params["failure_kind"]:
+            out.append("G and H of different kinds (the family has mixed_regions=False)")
         if params["target_convex"] not in self.target_convex:
             out.append(f"target_convex={params['target_convex']} not in {self.target_convex}")
         rng_ok("target_vertices", *self.target_vertices)
@@ -427,11 +434,13 @@ def _try_family(fam: SceneFamily, rng: np.random.Generator) -> tuple[dict | None
         return None
 
     regions = []
+    kind = fam.region_kinds[int(rng.integers(len(fam.region_kinds)))]
     for _ in range(2):
         c = sample_in(inner)
         if c is None:
             return None, "no room for G/H"
-        kind = fam.region_kinds[int(rng.integers(len(fam.region_kinds)))]
+        if fam.mixed_regions and regions:
+            kind = fam.region_kinds[int(rng.integers(len(fam.region_kinds)))]
         X = _region(rng, c, kind, float(rng.uniform(0.3, 0.8)))
         X = Polygon(_round(_coords(X))) if isinstance(X, Polygon) else Point(_round(_coords(X))[0])
         regions.append(X)

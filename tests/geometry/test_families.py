@@ -123,3 +123,15 @@ def test_bad_ranges_and_impossible_families_fail_clearly():
     tight = SceneFamily("tight", diameter=(4.0, 4.2), clutter=(0.5, 0.6), max_tries=5)
     with pytest.raises(RuntimeError, match="'tight': no valid scene in 5 draws"):
         tight.sample(np.random.default_rng(0))
+
+
+def test_g_and_h_share_a_kind_unless_mixed():
+    kinds = [scene_parameters(HARD.sample(np.random.default_rng([4, k]))) for k in range(30)]
+    assert {(p["goal_kind"], p["failure_kind"]) for p in kinds} == {
+        ("point", "point"),
+        ("polygon", "polygon"),
+    }
+    mixed = dataclasses.replace(HARD, name="mixed", mixed_regions=True)
+    pairs = [scene_parameters(mixed.sample(np.random.default_rng([4, k]))) for k in range(30)]
+    odd = [p for p in pairs if p["goal_kind"] != p["failure_kind"]]
+    assert odd and mixed.contains(odd[0]) and not HARD.contains(odd[0])
