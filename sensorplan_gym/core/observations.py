@@ -21,6 +21,10 @@ obstacles, G, H), its own pose, and its sensor readings.  The hidden target of
     With ``sensor_fov=True``, one more value last: the sensor's field of view divided by
     360 degrees (in (0, 1]) -- the robot knows its own sensor, and on scenes whose field of
     view varies it tells how far apart G and H may lie in one view.
+    With ``self_features=True``, two more values last: the field of view divided by 360
+    degrees and the sensor's reach (its maximum range, at most the scene's diameter) divided
+    by the scene's diameter (1: unlimited), both in (0, 1] -- what the robot knows about its
+    own sensor, so one policy can serve scene families whose sensors differ.
 
     Placement, length ``8 + 2 * n_beams``: centres of G and H scaled to [-1, 1],
     the width and height of G and H's bounding boxes divided by the scene's span,
@@ -93,13 +97,16 @@ class RobotVectorObs:
         map_ranges: bool = False,
         map_evidence: bool = False,
         sensor_fov: bool = False,
+        self_features: bool = False,
     ) -> None:
         self.n = n_beams
         n = n_beams
         self.map_ranges = map_ranges
         self.map_evidence = map_evidence
         self.sensor_fov = sensor_fov
+        self.self_features = self_features
         m = (n if map_ranges else 0) + (2 * n if map_evidence else 0) + (1 if sensor_fov else 0)
+        m += 2 if self_features else 0
         low = np.concatenate([-np.ones(8), np.zeros(n), -np.ones(2 * n), np.zeros(m)])
         self.space = spaces.Box(
             low.astype(np.float32), np.ones(8 + 3 * n + m, dtype=np.float32), dtype=np.float32
@@ -126,12 +133,17 @@ class RobotVectorObs:
 
     def tail(self, sim: BatchSim, sel, x, y, psi) -> np.ndarray:
         """The entries after :attr:`head` ``(k, D - head)`` float64: ``map_evidence``'s
-        flags, then ``sensor_fov``.  A new entry goes here (and in the space's bounds)."""
+        flags, then ``sensor_fov``, then ``self_features``.  A new entry goes here (and in
+        the space's bounds)."""
         parts = []
         if self.map_evidence:
             parts.append(map_evidence(sim, sel, x, y, psi).reshape(len(x), 2 * self.n))
         if self.sensor_fov:
             parts.append((sim.fov[sel] / (2.0 * math.pi))[:, None])
+        if self.self_features:  # fov / 360 degrees, reach / diameter (obs_consts[4] = 1/diameter)
+            fov = sim.fov[sel] / (2.0 * math.pi)
+            reach = np.minimum(sim.reach[sel] * sim.obs_consts[sel, 4], 1.0)
+            parts.append(np.column_stack([fov, reach]))
         return np.concatenate(parts, axis=1)
 
     def _numpy(self, sim: BatchSim, idx: np.ndarray) -> np.ndarray:
@@ -281,10 +293,12 @@ def make_observation(
     map_ranges: bool = False,
     map_evidence: bool = False,
     sensor_fov: bool = False,
+    self_features: bool = False,
 ):
     """The observation builder for env ``kind`` ("robot" or "placement") and ``obs_type``;
-    ``map_ranges`` / ``map_evidence`` / ``sensor_fov``: robot vector observations carry the
-    map-predicted ranges / the per-beam evidence flags / the field of view too."""
+    ``map_ranges`` / ``map_evidence`` / ``sensor_fov`` / ``self_features``: robot vector
+    observations carry the map-predicted ranges / the per-beam evidence flags / the field of
+    view / the field of view and the reach too."""
     if obs_type not in OBS_TYPES:
         raise ValueError(f"obs_type must be one of {OBS_TYPES}, got {obs_type!r}")
     table = {
@@ -293,12 +307,13 @@ def make_observation(
         ("placement", "vector"): PlacementVectorObs,
         ("placement", "grid"): PlacementGridObs,
     }
-    if map_ranges or map_evidence or sensor_fov:
+    if map_ranges or map_evidence or sensor_fov or self_features:
         return RobotVectorObs(
             n_beams,
             grid_size,
             map_ranges=map_ranges,
             map_evidence=map_evidence,
             sensor_fov=sensor_fov,
+            self_features=self_features,
         )
     return table[(kind, obs_type)](n_beams, grid_size)

@@ -3,7 +3,8 @@ scenes (``scene="random"``).
 
 A :class:`ScenePool` of ``size`` scenes is deterministic in ``seed``: scene ``k`` is drawn by
 :func:`geometry.generate.random_scene` from ``numpy.random.default_rng([seed, k])`` (re-drawn
-from the same stream while it cannot host an episode), so every process, every
+from the same stream while it cannot host an episode) -- or, with ``family=``, by
+:meth:`geometry.families.SceneFamily.sample_dict` from the same stream -- so every process, every
 sub-environment and every run sees the same scene ``k``.  Scenes are built on first use and
 kept (pools are shared between environments of a process with the same arguments), so after
 the first draws a reset only picks an index: nothing is generated on the hot path.  Disjoint
@@ -19,6 +20,8 @@ from typing import Any
 import numpy as np
 
 from geometry import Scene
+from geometry.families import SceneFamily
+from geometry.generate import random_scene
 
 from .cache import get_world
 from .world import World, WorldConfig
@@ -52,6 +55,7 @@ class ScenePool:
         seed: int = 0,
         scene_kwargs: dict | None = None,
         max_tries: int = 25,
+        family: SceneFamily | None = None,
     ) -> None:
         if not isinstance(size, (int, np.integer)) or size < 1:
             raise ValueError(f"scene_pool_size must be a positive integer, got {size!r}")
@@ -60,6 +64,11 @@ class ScenePool:
         self.cfg, self.check = cfg, check
         self.size, self.seed = int(size), int(seed)
         self.scene_kwargs = dict(scene_kwargs or {})
+        if family is not None and not isinstance(family, SceneFamily):
+            raise TypeError(f"family must be a geometry.families.SceneFamily, got {family!r}")
+        if family is not None and self.scene_kwargs:
+            raise ValueError("give random_scene_kwargs or a scene family, not both")
+        self.family = family
         self.max_tries = int(max_tries)
         self.entries: dict[int, tuple[World, Start]] = {}
 
@@ -70,12 +79,13 @@ class ScenePool:
         """Scene ``k`` (built on first use)."""
         e = self.entries.get(k)
         if e is None:
-            from geometry.generate import random_scene
-
             rng = np.random.default_rng([self.seed, k])
             last = None
             for _ in range(self.max_tries):
-                d = random_scene(rng, **self.scene_kwargs)
+                if self.family is not None:
+                    d = self.family.sample_dict(rng)
+                else:
+                    d = random_scene(rng, **self.scene_kwargs)
                 world = get_world(Scene.from_dict(d), self.cfg, d)
                 start, last = self.check(world, rng)
                 if last is None:

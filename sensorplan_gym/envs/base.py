@@ -22,9 +22,15 @@ scene : str | path | dict | geometry.Scene, default ``"lab"``
     from the start, or that contain the start are re-drawn when the pool is built).
 scene_pool_size : int, default 64 -- scenes in the ``"random"`` pool.
 scene_pool_seed : int, default 0 -- the pool's seed (disjoint seeds: disjoint splits).
-min_start_distance : float, default 0 -- a difficulty knob for ``scene="random"``: pool
-    scenes whose start lies closer than this fraction of the scene diameter to the
-    recognizable region are re-drawn (Navigate, Recognize).
+min_start_distance : float | None, default None (0, or the ``difficulty``'s) -- a difficulty
+    knob for ``scene="random"``: pool scenes whose start lies closer than this fraction of the
+    scene diameter to the recognizable region are re-drawn (Navigate, Recognize).
+family : str | geometry.families.SceneFamily | None -- with ``scene="random"``, draw the pool
+    from this scene family (``"easy"``, ``"medium"``, ``"hard"`` or a ``SceneFamily``) instead
+    of :func:`geometry.generate.random_scene` (the default, unchanged).
+difficulty : ``"easy"`` | ``"medium"`` | ``"hard"`` | None -- with ``scene="random"``, a
+    benchmark level (:data:`geometry.families.DIFFICULTIES`): its family and its
+    ``min_start_distance`` (an explicit ``min_start_distance`` wins).
 model : ``"complete"`` | ``"partial"`` -- the visibility model of the recognizable region.
 motion : ``"stationary"`` | ``"translating"`` | ``"rotating"`` (see
     :mod:`sensorplan_gym.core.world`).  Unsupported combinations raise
@@ -49,6 +55,9 @@ map_evidence : bool, default False -- per beam, whether it read shorter than the
     the map; vector observations of Navigate/Recognize).
 sensor_fov : bool, default False -- Navigate/Recognize vector observations end with the
     sensor's field of view / 360 degrees (for scenes whose field of view varies).
+self_features : bool, default False -- Navigate/Recognize vector observations end with what
+    the robot knows of its own sensor: field of view / 360 degrees and reach (maximum range,
+    at most the diameter) / scene diameter (for scene families whose sensors differ).
 max_steps : int | None -- the time limit (default 200; Placement: 1).
 random_scene_kwargs : dict | None -- passed to ``random_scene`` when ``scene="random"``.
 render_mode : ``None`` | ``"rgb_array"`` | ``"human"``.
@@ -73,11 +82,14 @@ import gymnasium as gym
 import numpy as np
 import shapely
 
+from geometry.families import SceneFamily, get_difficulty, get_family
+
 from ..core import fused
 from ..core.actions import make_actions
 from ..core.cache import get_world
 from ..core.observations import make_observation
 from ..core.pool import FixedScene, shared_pool
+from ..core.queries import aim_ok_batch
 from ..core.rendering import HumanViewer, Renderer
 from ..core.sensor import NOISE_BOUND, RangeSensor
 from ..core.sim import BatchSim
@@ -134,7 +146,48 @@ def _sampled_start(world: World, rng: np.random.Generator, tries: int = 10_000) 
     return None
 
 
-def _check(
+def _has_view(
+    world: World, space: shapely.Geometry, rng: np.random.Generator, n: int = 256
+) -> bool:
+    """Whether a pose with its position in ``space`` (a part of the recognizable region) keeps
+    K_G and K_H in the field of view and within range (:meth:`World.aim_ok`), found among
+    ``n`` positions drawn from ``rng`` in ``space`` and seven aims each (the one between the
+    directions to K_G and K_H, and that one turned by +-0.1, 0.2, 0.3 field of view).
+    ``True`` without drawing for a 360-degree sensor of unlimited range.  A sampled test:
+    ``False`` may miss a thin set of such poses (the scene is then re-drawn)."""
+    if world.fov >= 2 * math.pi - 1e-12 and math.isinf(world.max_range):
+        return True
+    if space.is_empty:
+        return False
+    x0, y0, x1, y1 = space.bounds
+    pts = rng.uniform((x0, y0), (x1, y1), (8 * n, 2))
+    pts = pts[shapely.contains_xy(space, pts[:, 0], pts[:, 1])][:n]
+    if len(pts) == 0:
+        return False
+    r = world.batch_rows()
+    c = r["centers"]
+    a = np.arctan2(c[0, 1] - pts[:, 1], c[0, 0] - pts[:, 0])
+    b = np.arctan2(c[1, 1] - pts[:, 1], c[1, 0] - pts[:, 0])
+    mid = a + 0.5 * ((b - a + math.pi) % (2 * math.pi) - math.pi)
+    turns = world.fov * np.array([0.0, -0.1, 0.1, -0.2, 0.2, -0.3, 0.3])
+    psi = (mid[:, None] + turns[None, :]).ravel()
+    xs, ys = np.repeat(pts[:, 0], len(turns)), np.repeat(pts[:, 1], len(turns))
+    m = len(psi)
+    ok = aim_ok_batch(
+        xs,
+        ys,
+        psi,
+        np.broadcast_to(r["hulls"][None], (m, *r["hulls"].shape)),
+        np.broadcast_to(c[None], (m, *c.shape)),
+        fov=world.fov,
+        eps_aim=world.eps_aim,
+        eps_pos=world.eps_pos,
+        max_range=world.max_range,
+    )
+    return bool(ok.any())
+
+
+def _check_pose(
     world: World,
     rng: np.random.Generator,
     needs_start: bool,
@@ -169,6 +222,55 @@ def _check(
     return start, problem
 
 
+def _check(
+    world: World,
+    rng: np.random.Generator,
+    needs_start: bool,
+    min_start_distance: float = 0.0,
+    fallback_start: bool = False,
+    needs_view: bool = False,
+):
+    """``(start, problem)`` of a world (see :func:`_check_pose`).  With ``needs_view``
+    (scene-family pools of tasks whose success is one recognizing pose), a world where no
+    sampled pose of the (reachable) region keeps G and H in view is a problem too
+    (:func:`_has_view`)."""
+    start, problem = _check_pose(world, rng, needs_start, min_start_distance, fallback_start)
+    if problem is None and needs_view:
+        space = world.reachable_region(start[:2]) if needs_start else world.region
+        if not _has_view(world, space, rng):
+            problem = "no sampled pose of the region keeps G and H in the field of view and range"
+    return start, problem
+
+
+def _resolve_family(
+    random: bool,
+    family: str | SceneFamily | None,
+    difficulty: str | None,
+    min_start_distance: float | None,
+    random_scene_kwargs: dict | None,
+) -> tuple[SceneFamily | None, float | None]:
+    """``(scene family or None, min_start_distance)`` from the envs' ``family`` /
+    ``difficulty`` / ``min_start_distance`` kwargs (an explicit ``min_start_distance`` wins
+    over the difficulty's; ``None`` stays ``None`` without a difficulty)."""
+    if family is None and difficulty is None:
+        return None, min_start_distance
+    if not random:
+        raise ValueError("family= and difficulty= need scene='random'")
+    if random_scene_kwargs:
+        raise ValueError("give random_scene_kwargs or family=/difficulty=, not both")
+    if difficulty is not None:
+        level = get_difficulty(difficulty)
+        if family is not None and get_family(family) != level.family:
+            raise ValueError(
+                f"difficulty={difficulty!r} has its own family ({level.family.name!r}); "
+                f"drop family={family!r} or the difficulty"
+            )
+        if min_start_distance is None:
+            min_start_distance = level.min_start_distance
+        return level.family, min_start_distance
+    return get_family(family), min_start_distance
+
+
 class SensorPlanBatch(BatchSim):
     """A task over N sub-environments; subclasses define ``obs_kind``, ``action_dim`` and the
     hooks ``_reset_one`` (Python, per resetting sub-environment: draws from its generator),
@@ -179,6 +281,8 @@ class SensorPlanBatch(BatchSim):
     action_dim = 3
     action_task = "robot"
     horizon = 200
+    #: success is one pose that keeps G and H in view (family pools re-draw scenes without one)
+    joint_view = True
 
     def __init__(
         self,
@@ -198,7 +302,9 @@ class SensorPlanBatch(BatchSim):
         robot_radius: float = 0.0,
         random_scene_kwargs: dict | None = None,
         max_scene_tries: int = 25,
-        min_start_distance: float = 0.0,
+        min_start_distance: float | None = None,
+        family: str | SceneFamily | None = None,
+        difficulty: str | None = None,
         scene_pool_size: int = 64,
         scene_pool_seed: int = 0,
         max_steps: int | None = None,
@@ -206,6 +312,7 @@ class SensorPlanBatch(BatchSim):
         map_ranges: bool = False,
         map_evidence: bool = False,
         sensor_fov: bool = False,
+        self_features: bool = False,
         **action_kw: Any,
     ) -> None:
         for name, v in (
@@ -242,6 +349,7 @@ class SensorPlanBatch(BatchSim):
             ("map_ranges", map_ranges),
             ("map_evidence", map_evidence),
             ("sensor_fov", sensor_fov),
+            ("self_features", self_features),
         ):
             if not isinstance(v, bool):
                 raise ValueError(f"{name} must be True or False, got {v!r}")
@@ -260,6 +368,7 @@ class SensorPlanBatch(BatchSim):
             map_ranges=map_ranges,
             map_evidence=map_evidence,
             sensor_fov=sensor_fov,
+            self_features=self_features,
         )
         self.single_observation_space = self.obs.space
         self.actions = make_actions(action_type, self.action_task, self.action_dim, **action_kw)
@@ -269,20 +378,30 @@ class SensorPlanBatch(BatchSim):
         # episode from the next step of the current one by it (agents.planning.oracle)
         self.episodes = np.zeros(self.n, dtype=np.int64)
         self.random = isinstance(scene, str) and scene == "random"
+        family, min_start_distance = _resolve_family(
+            self.random, family, difficulty, min_start_distance, random_scene_kwargs
+        )
+        if min_start_distance is None:
+            min_start_distance = 0.0
         if not isinstance(min_start_distance, (int, float)) or not 0 <= min_start_distance < 1:
             raise ValueError(f"min_start_distance must be in [0, 1), got {min_start_distance!r}")
         self.min_start_distance = float(min_start_distance)
         check = functools.partial(_check, needs_start=self.needs_start)
         if self.random:
-            check = functools.partial(check, min_start_distance=self.min_start_distance)
+            view = family is not None and self.joint_view
+            check = functools.partial(
+                check, min_start_distance=self.min_start_distance, needs_view=view
+            )
             self.source = shared_pool(
                 self.cfg,
                 check,
-                f"start>={self.min_start_distance}" if self.needs_start else "nostart",
+                (f"start>={self.min_start_distance}" if self.needs_start else "nostart")
+                + ("+view" if view else ""),
                 size=scene_pool_size,
                 seed=scene_pool_seed,
                 scene_kwargs=dict(random_scene_kwargs or {}),
                 max_tries=max_scene_tries,
+                family=family,
             )
             world, start = self.source.get(0)  # unsupported configurations fail here
         else:

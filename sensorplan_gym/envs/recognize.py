@@ -65,6 +65,7 @@ class RecognizeBatch(RobotBatch):
     obs_kind = "robot"
     action_dim = 4
     action_task = "recognize"
+    joint_view = False  # the robot may look at G, then at H
     # side: _G or _H, where the hidden target is; hold: consecutive steps pointing at one
     # label; pointing: that label; declared: the declared label (_NONE: none yet)
     I8_NAMES = ("elapsed", "side", "hold", "pointing", "declared")
