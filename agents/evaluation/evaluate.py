@@ -48,6 +48,7 @@ from ..learning.policies import (
     load_policy,
     make_env,
     model_config,
+    play_env_kwargs,
     policy_label,
 )
 from .episodes import EVAL_SEED_BASE, run_episodes
@@ -260,7 +261,10 @@ def evaluate(
         "files": {},
     }
     for name, spec in zip(names, policies, strict=True):
-        env = make_env(env_id, env_kwargs)
+        play_kwargs = env_kwargs
+        if spec not in ("oracle", "random"):
+            play_kwargs = play_env_kwargs(model_config(spec), env_kwargs)
+        env = make_env(env_id, play_kwargs)
         try:
             policy = load_policy(spec, env, seed=seed)
             meta: dict[str, Any] = {"kind": spec if spec in ("oracle", "random") else "model"}
@@ -271,6 +275,7 @@ def evaluate(
                         "algo": cfg.get("algo") or type(policy).__name__.lower(),
                         "train_seed": cfg.get("seed"),
                         "train_env_kwargs": cfg.get("env_kwargs"),
+                        "play_env_kwargs": play_kwargs,
                     }
                 )
                 if cfg.get("env_id") not in (None, env_id):
@@ -293,7 +298,7 @@ def evaluate(
             if backend == "ray":
                 ep = run_episodes_ray(
                     env_id,
-                    env_kwargs,
+                    play_kwargs,
                     spec,
                     seeds,
                     seed=seed,
