@@ -5,6 +5,10 @@
 
 Splits (each an env-kwargs override on top of ``--env-kwargs``):
 
+Procedural splits of tasks with a start (Navigate, Recognize) draw a start per episode
+(``random_start=True``); every result reports its number of distinct (scene, start) episodes
+(``distinct_episodes``), which sizes its Wilson interval.
+
 * ``train`` -- procedural scenes from the pool of seed :data:`TRAIN_POOL_SEED` (what
   ``scene="random"`` trains on by default);
 * ``test`` -- procedural scenes from the disjoint pool of seed :data:`TEST_POOL_SEED`, never
@@ -53,6 +57,8 @@ def splits(names: list[str], difficulty: float, needs_start: bool) -> dict[str, 
         if needs_start and difficulty > 0
         else {}
     )
+    if needs_start:  # a start drawn per episode: 100 episodes are not 64 scene-start pairs
+        hard = {"random_start": True, **hard}
     out: dict[str, dict] = {}
     for name in names:
         if name == "train":
@@ -147,6 +153,7 @@ def benchmark(
                     "success_rate": p["success_rate"],
                     "ci_low": p["success_ci95"][0],
                     "ci_high": p["success_ci95"][1],
+                    "distinct_episodes": p["distinct_episodes"],
                     "mean_return": p["mean_return"],
                     "mean_steps": p["mean_steps"],
                     "mean_path_length": p["mean_path_length"],

@@ -64,7 +64,11 @@ _REWARD_ONLY = {"shaping", "step_cost", "success_bonus"}
 def _summary(name: str, spec: str, ep: dict[str, list], meta: dict) -> dict[str, Any]:
     n = len(ep["success"])
     k = int(sum(ep["success"]))
-    lo, hi = wilson_interval(k, n)
+    # repeated (scene, start) pairs are not independent trials: the interval is sized by
+    # the number of distinct episodes m, at the measured rate (k/n successes of m)
+    keys = ep.get("episode_key")
+    m = len(set(keys)) if keys else n
+    lo, hi = wilson_interval(k * m / n, m) if n else wilson_interval(0, 0)
     if n:  # guard against round-off at 0 or n successes (e.g. a 5e-17 lower bound at 0/n)
         lo, hi = min(lo, k / n), max(hi, k / n)
     return {
@@ -73,6 +77,7 @@ def _summary(name: str, spec: str, ep: dict[str, list], meta: dict) -> dict[str,
         **meta,
         "episodes": n,
         "successes": k,
+        "distinct_episodes": m,
         "success_rate": k / n if n else float("nan"),
         "success_ci95": [lo, hi],
         "mean_return": float(np.mean(ep["return"])),
