@@ -98,3 +98,38 @@ def test_wilson_interval_is_sized_by_distinct_episodes():
     wide = s["success_ci95"][1] - s["success_ci95"][0]
     lo, hi = wilson_interval(50, 100)
     assert wide > hi - lo
+
+
+def _pool_fingerprint(env_id: str, kw: dict) -> list[tuple]:
+    env = gym.make(env_id, **kw)
+    src = env.unwrapped.batch.source
+    out = []
+    for k in range(src.size):
+        w, start = src.get(k)
+        out.append((round(w.region.area, 9), tuple(np.round(w.lo, 9)), tuple(np.round(w.hi, 9))))
+    env.close()
+    return out
+
+
+def test_train_split_is_the_training_pool():
+    from pathlib import Path
+
+    from agents.evaluation.benchmark import training_pool
+    from agents.learning.policies import model_config
+
+    shipped = Path(__file__).resolve().parents[2] / "agents" / "pretrained"
+    rec = str(shipped / "ppo_recognize_random.zip")
+    trained = model_config(rec)["env_kwargs"]
+    pool = training_pool(["oracle", rec])
+    assert pool["min_start_distance"] == trained["min_start_distance"]
+    sp = splits(["train", "test"], 0.35, needs_start=True, train_pool=pool)
+    env_id = "sensorplan/Recognize-v0"
+    train_kw = {k: trained[k] for k in ("scene", "min_start_distance", "max_scene_tries")}
+    assert _pool_fingerprint(env_id, sp["train"]) == _pool_fingerprint(env_id, train_kw)
+    # without a model trained on random scenes: the default pool of seed TRAIN_POOL_SEED
+    assert training_pool(["oracle", "random"]) is None
+    # models of different pools have no one training pool
+    nav = str(shipped / "ppo_navigate_random.zip")
+    if training_pool([nav]) != pool:
+        with pytest.raises(ValueError, match="different scene pools"):
+            training_pool([rec, nav])
