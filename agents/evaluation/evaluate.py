@@ -12,9 +12,11 @@ deterministically, or with ``deterministic=False`` (``--stochastic``) sample the
 When the episodes replay one fixed scene from one fixed start (a bundled scene without
 ``random_start``), a deterministic policy plays nearly the same episode each time: only the
 target's side and place and the pose noise vary.  The episodes are then not independent
-samples of the policy's skill, the Wilson interval is too narrow, and the results carry
-``independent_episodes: false`` and a printed note; the interval across training seeds (IQM)
-is the honest one.
+samples of the policy's skill: the results carry ``independent_episodes: false`` and a
+printed note, and each policy's ``distinct_episodes`` (distinct scene and start pairs, see
+:func:`agents.evaluation.episodes.episode_key`) sizes its Wilson interval (``k/n`` successes
+of ``distinct_episodes`` trials), so one start gives a wide interval; the interval across
+training seeds (IQM) is the honest one.
 
 Per policy: success rate (``info["is_success"]`` at the episode's last step) with its 95%
 Wilson interval, mean return, mean steps, mean path length (the sum of the position changes
@@ -401,8 +403,8 @@ def evaluate(
         if fixed:
             print(
                 "note: every episode starts from the scene's fixed start, so a deterministic "
-                "policy replays nearly one episode; the Wilson intervals treat them as "
-                "independent and are too narrow -- compare training seeds (IQM) instead"
+                "policy replays nearly one episode; the Wilson intervals are sized by the "
+                "distinct (scene, start) episodes -- compare training seeds (IQM) too"
             )
         if results["files"]:
             print("wrote " + ", ".join(results["files"].values()))
