@@ -236,7 +236,7 @@ def format_rows(res: dict[str, Any]) -> str:
     """A plain-text table of ``res["rows"]``."""
     head = (
         f"{'split':<16} {'policy':<28} {'success':>7} {'95% CI':>15} {'return':>7} "
-        f"{'steps':>6} {'norm.':>6} {'start d':>7}"
+        f"{'steps':>6} {'norm.':>6} {'start d':>7} {'distinct':>8}"
     )
     lines = [head, "-" * len(head)]
     for r in res["rows"]:
@@ -245,8 +245,11 @@ def format_rows(res: dict[str, Any]) -> str:
         lines.append(
             f"{r['split']:<16} {r['policy'][:28]:<28} {r['success_rate']:7.3f} "
             f"[{r['ci_low']:.3f}, {r['ci_high']:.3f}] {r['mean_return']:7.3f} "
-            f"{r['mean_steps']:6.1f} {ns:>6} {sd:>7}"
+            f"{r['mean_steps']:6.1f} {ns:>6} {sd:>7} {r['distinct_episodes']:>8}"
         )
     d = res["difficulty"]["min_start_distance"]
-    lines.append(f"difficulty: min_start_distance = {d} (start d: mean start distance / diameter)")
+    lines.append(
+        f"difficulty: min_start_distance = {d} (start d: mean start distance / diameter; "
+        "distinct: distinct (scene, start) episodes, which size the 95% CI)"
+    )
     return "\n".join(lines)
