@@ -5,8 +5,14 @@
 
 Splits (each an env-kwargs override on top of ``--env-kwargs``):
 
-* ``train`` -- procedural scenes from the pool of seed :data:`TRAIN_POOL_SEED` (what
-  ``scene="random"`` trains on by default);
+Procedural splits of tasks with a start (Navigate, Recognize) draw a start per episode
+(``random_start=True``); every result reports its number of distinct (scene, start) episodes
+(``distinct_episodes``), which sizes its Wilson interval.
+
+* ``train`` -- the training pool: the scene pool the model policies were trained on (the
+  pool kwargs of their resolved configs, :data:`POOL_KWARGS`, at their own
+  ``min_start_distance``); without a model trained on ``scene="random"``, the pool of seed
+  :data:`TRAIN_POOL_SEED` (what ``scene="random"`` trains on by default);
 * ``test`` -- procedural scenes from the disjoint pool of seed :data:`TEST_POOL_SEED`, never
   trained on;
 * ``ood`` -- every bundled scene (``lab``, ``edr``, ``corridor``, ``warehouse``), one split
@@ -37,15 +43,63 @@ from ..learning.policies import check_policies, make_env
 from .episodes import EVAL_SEED_BASE
 from .evaluate import evaluate, fresh_dir
 
-__all__ = ["DEFAULT_DIFFICULTY", "TEST_POOL_SEED", "TRAIN_POOL_SEED", "benchmark", "splits"]
+__all__ = [
+    "DEFAULT_DIFFICULTY",
+    "POOL_KWARGS",
+    "TEST_POOL_SEED",
+    "TRAIN_POOL_SEED",
+    "benchmark",
+    "splits",
+    "training_pool",
+]
 
 TRAIN_POOL_SEED = 0
 TEST_POOL_SEED = 1
 DEFAULT_DIFFICULTY = 0.35
 
 
-def splits(names: list[str], difficulty: float, needs_start: bool) -> dict[str, dict]:
-    """Env-kwargs overrides of the named splits (``ood`` expands to one split per scene)."""
+# env kwargs that decide which scenes a scene="random" pool holds (and their defaults)
+POOL_KWARGS = {
+    "scene_pool_seed": TRAIN_POOL_SEED,
+    "scene_pool_size": 64,
+    "min_start_distance": 0.0,
+    "max_scene_tries": 25,
+    "random_scene_kwargs": None,
+}
+
+
+def training_pool(policies: list[str]) -> dict | None:
+    """The pool the model policies were trained on: the :data:`POOL_KWARGS` of their resolved
+    configs' env kwargs (defaults filled in), for models trained on ``scene="random"``;
+    ``None`` when none was.  Raises ``ValueError`` naming the models when their pools differ
+    (benchmark them separately: one ``train`` split is one pool)."""
+    from ..learning.policies import model_config
+
+    pools: dict[str, list[str]] = {}
+    for spec in policies:
+        if spec in ("oracle", "random"):
+            continue
+        kw = (model_config(spec) or {}).get("env_kwargs") or {}
+        if kw.get("scene") != "random":
+            continue
+        pool = {k: kw.get(k, d) for k, d in POOL_KWARGS.items()}
+        pools.setdefault(json.dumps(pool, sort_keys=True), []).append(spec)
+    if len(pools) > 1:
+        raise ValueError(
+            "the models were trained on different scene pools, so no one train split is "
+            "their training pool; benchmark them separately: "
+            + "; ".join(f"{', '.join(v)}: {k}" for k, v in pools.items())
+        )
+    return json.loads(next(iter(pools))) if pools else None
+
+
+def splits(
+    names: list[str], difficulty: float, needs_start: bool, train_pool: dict | None = None
+) -> dict[str, dict]:
+    """Env-kwargs overrides of the named splits (``ood`` expands to one split per scene).
+    ``train`` is ``train_pool`` (see :func:`training_pool`; its own ``min_start_distance``
+    replaces ``difficulty``) when given, else the default pool of seed
+    :data:`TRAIN_POOL_SEED` at ``difficulty``."""
     from sensorplan_gym import BUNDLED_SCENES
 
     hard = (
@@ -53,9 +107,17 @@ def splits(names: list[str], difficulty: float, needs_start: bool) -> dict[str, 
         if needs_start and difficulty > 0
         else {}
     )
+    if needs_start:  # a start drawn per episode: 100 episodes are not 64 scene-start pairs
+        hard = {"random_start": True, **hard}
     out: dict[str, dict] = {}
     for name in names:
-        if name == "train":
+        if name == "train" and train_pool is not None:
+            pool = {k: v for k, v in train_pool.items() if v is not None}
+            if not needs_start:
+                pool.pop("min_start_distance", None)
+            start = {"random_start": True} if needs_start else {}
+            out[name] = {"scene": "random", **start, **pool}
+        elif name == "train":
             out[name] = {"scene": "random", "scene_pool_seed": TRAIN_POOL_SEED, **hard}
         elif name == "test":
             out[name] = {"scene": "random", "scene_pool_seed": TEST_POOL_SEED, **hard}
@@ -112,7 +174,9 @@ def benchmark(
     probe = make_env(env_id, {k: v for k, v in base.items() if k != "scene"})
     needs_start = bool(probe.unwrapped.batch.needs_start)
     probe.close()
-    sp = splits(split_names or ["train", "test", "ood"], difficulty, needs_start)
+    names = split_names or ["train", "test", "ood"]
+    pool = training_pool(policies) if "train" in names else None
+    sp = splits(names, difficulty, needs_start, train_pool=pool)
     res: dict[str, Any] = {
         "env_id": env_id,
         "difficulty": {"min_start_distance": difficulty if needs_start else None},
@@ -138,6 +202,7 @@ def benchmark(
             deterministic=deterministic,
         )
         r["start_distance"] = _start_distance(env_id, kw, seeds)
+        r["min_start_distance"] = kw.get("min_start_distance") if needs_start else None
         res["splits"][name] = r
         for p in r["policies"]:
             res["rows"].append(
@@ -147,11 +212,13 @@ def benchmark(
                     "success_rate": p["success_rate"],
                     "ci_low": p["success_ci95"][0],
                     "ci_high": p["success_ci95"][1],
+                    "distinct_episodes": p["distinct_episodes"],
                     "mean_return": p["mean_return"],
                     "mean_steps": p["mean_steps"],
                     "mean_path_length": p["mean_path_length"],
                     "normalized_score": p.get("normalized_score"),
                     "start_distance": r["start_distance"],
+                    "min_start_distance": r["min_start_distance"],
                 }
             )
     out.mkdir(parents=True, exist_ok=True)  # evaluate made it, unless no split ran
@@ -169,7 +236,7 @@ def format_rows(res: dict[str, Any]) -> str:
     """A plain-text table of ``res["rows"]``."""
     head = (
         f"{'split':<16} {'policy':<28} {'success':>7} {'95% CI':>15} {'return':>7} "
-        f"{'steps':>6} {'norm.':>6} {'start d':>7}"
+        f"{'steps':>6} {'norm.':>6} {'start d':>7} {'distinct':>8}"
     )
     lines = [head, "-" * len(head)]
     for r in res["rows"]:
@@ -178,8 +245,11 @@ def format_rows(res: dict[str, Any]) -> str:
         lines.append(
             f"{r['split']:<16} {r['policy'][:28]:<28} {r['success_rate']:7.3f} "
             f"[{r['ci_low']:.3f}, {r['ci_high']:.3f}] {r['mean_return']:7.3f} "
-            f"{r['mean_steps']:6.1f} {ns:>6} {sd:>7}"
+            f"{r['mean_steps']:6.1f} {ns:>6} {sd:>7} {r['distinct_episodes']:>8}"
         )
     d = res["difficulty"]["min_start_distance"]
-    lines.append(f"difficulty: min_start_distance = {d} (start d: mean start distance / diameter)")
+    lines.append(
+        f"difficulty: min_start_distance = {d} (start d: mean start distance / diameter; "
+        "distinct: distinct (scene, start) episodes, which size the 95% CI)"
+    )
     return "\n".join(lines)

@@ -23,11 +23,31 @@ def _xy(info: dict) -> np.ndarray | None:
     return np.asarray(pose[:2], dtype=float)
 
 
+def episode_key(env, info: dict) -> str:
+    """What makes an episode distinct: its scene (name, bounds and region area, to 12
+    significant digits) and its start pose (``info["pose"]`` after reset, scene units and
+    radians; none for Placement).  Two episodes with the same key replay the same problem."""
+    w = env.unwrapped.world
+    parts = [w.scene.name, *(f"{float(v):.12g}" for v in (*w.lo, *w.hi, w.region.area))]
+    pose = info.get("pose")
+    if pose is not None:
+        parts += [f"{float(v):.12g}" for v in pose[:3]]
+    return "|".join(parts)
+
+
 def run_episodes(env, policy, seeds: list[int], *, deterministic: bool = True) -> dict[str, list]:
-    """Play one episode per seed; per-episode success, return, steps and path length."""
-    out: dict[str, list] = {"success": [], "return": [], "steps": [], "path_length": []}
+    """Play one episode per seed; per-episode success, return, steps, path length and
+    :func:`episode_key` (``"episode_key"``: which scene and start it played)."""
+    out: dict[str, list] = {
+        "success": [],
+        "return": [],
+        "steps": [],
+        "path_length": [],
+        "episode_key": [],
+    }
     for s in seeds:
         obs, info = env.reset(seed=int(s))
+        out["episode_key"].append(episode_key(env, info))
         state = None
         start = np.ones(1, dtype=bool)
         prev = _xy(info)

@@ -12,9 +12,11 @@ deterministically, or with ``deterministic=False`` (``--stochastic``) sample the
 When the episodes replay one fixed scene from one fixed start (a bundled scene without
 ``random_start``), a deterministic policy plays nearly the same episode each time: only the
 target's side and place and the pose noise vary.  The episodes are then not independent
-samples of the policy's skill, the Wilson interval is too narrow, and the results carry
-``independent_episodes: false`` and a printed note; the interval across training seeds (IQM)
-is the honest one.
+samples of the policy's skill: the results carry ``independent_episodes: false`` and a
+printed note, and each policy's ``distinct_episodes`` (distinct scene and start pairs, see
+:func:`agents.evaluation.episodes.episode_key`) sizes its Wilson interval (``k/n`` successes
+of ``distinct_episodes`` trials), so one start gives a wide interval; the interval across
+training seeds (IQM) is the honest one.
 
 Per policy: success rate (``info["is_success"]`` at the episode's last step) with its 95%
 Wilson interval, mean return, mean steps, mean path length (the sum of the position changes
@@ -48,6 +50,7 @@ from ..learning.policies import (
     load_policy,
     make_env,
     model_config,
+    play_env_kwargs,
     policy_label,
 )
 from .episodes import EVAL_SEED_BASE, run_episodes
@@ -63,7 +66,11 @@ _REWARD_ONLY = {"shaping", "step_cost", "success_bonus"}
 def _summary(name: str, spec: str, ep: dict[str, list], meta: dict) -> dict[str, Any]:
     n = len(ep["success"])
     k = int(sum(ep["success"]))
-    lo, hi = wilson_interval(k, n)
+    # repeated (scene, start) pairs are not independent trials: the interval is sized by
+    # the number of distinct episodes m, at the measured rate (k/n successes of m)
+    keys = ep.get("episode_key")
+    m = len(set(keys)) if keys else n
+    lo, hi = wilson_interval(k * m / n, m) if n else wilson_interval(0, 0)
     if n:  # guard against round-off at 0 or n successes (e.g. a 5e-17 lower bound at 0/n)
         lo, hi = min(lo, k / n), max(hi, k / n)
     return {
@@ -72,6 +79,7 @@ def _summary(name: str, spec: str, ep: dict[str, list], meta: dict) -> dict[str,
         **meta,
         "episodes": n,
         "successes": k,
+        "distinct_episodes": m,
         "success_rate": k / n if n else float("nan"),
         "success_ci95": [lo, hi],
         "mean_return": float(np.mean(ep["return"])),
@@ -260,7 +268,10 @@ def evaluate(
         "files": {},
     }
     for name, spec in zip(names, policies, strict=True):
-        env = make_env(env_id, env_kwargs)
+        play_kwargs = env_kwargs
+        if spec not in ("oracle", "random"):
+            play_kwargs = play_env_kwargs(model_config(spec), env_kwargs)
+        env = make_env(env_id, play_kwargs)
         try:
             policy = load_policy(spec, env, seed=seed)
             meta: dict[str, Any] = {"kind": spec if spec in ("oracle", "random") else "model"}
@@ -271,6 +282,7 @@ def evaluate(
                         "algo": cfg.get("algo") or type(policy).__name__.lower(),
                         "train_seed": cfg.get("seed"),
                         "train_env_kwargs": cfg.get("env_kwargs"),
+                        "play_env_kwargs": play_kwargs,
                     }
                 )
                 if cfg.get("env_id") not in (None, env_id):
@@ -293,7 +305,7 @@ def evaluate(
             if backend == "ray":
                 ep = run_episodes_ray(
                     env_id,
-                    env_kwargs,
+                    play_kwargs,
                     spec,
                     seeds,
                     seed=seed,
@@ -391,8 +403,8 @@ def evaluate(
         if fixed:
             print(
                 "note: every episode starts from the scene's fixed start, so a deterministic "
-                "policy replays nearly one episode; the Wilson intervals treat them as "
-                "independent and are too narrow -- compare training seeds (IQM) instead"
+                "policy replays nearly one episode; the Wilson intervals are sized by the "
+                "distinct (scene, start) episodes -- compare training seeds (IQM) too"
             )
         if results["files"]:
             print("wrote " + ", ".join(results["files"].values()))

@@ -10,8 +10,10 @@ from scipy import stats
 __all__ = ["iqm", "normalized_score", "stratified_bootstrap_ci", "wilson_interval"]
 
 
-def wilson_interval(successes: int, n: int, confidence: float = 0.95) -> tuple[float, float]:
+def wilson_interval(successes: float, n: int, confidence: float = 0.95) -> tuple[float, float]:
     """Wilson score interval for a success rate; returns ``(low, high)`` in [0, 1].
+    ``successes`` may be an effective (fractional) count, e.g. a rate measured over
+    repeated episodes times the number ``n`` of distinct ones.
 
     ``(0.0, 1.0)`` when ``n == 0``.
     """

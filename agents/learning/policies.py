@@ -214,6 +214,35 @@ def model_config(path: str | Path) -> dict | None:
     return None
 
 
+# env kwargs that fix what a model sees or what its actions mean: a model is played with the
+# values it was trained with (the user's kwargs override them; scene and starts are the user's)
+OBSERVATION_KWARGS = (
+    "n_beams",
+    "obs_type",
+    "grid_size",
+    "action_type",
+    "map_ranges",
+    "map_evidence",
+    "sensor_fov",
+    "declare_hold",
+    "placement_grid",
+    "placement_aims",
+)
+
+
+def play_env_kwargs(cfg: dict | None, env_kwargs: dict | None) -> dict:
+    """The env kwargs to play a model with: the observation/action kwargs of its resolved
+    training config ``cfg`` (:data:`OBSERVATION_KWARGS`), with the user's ``env_kwargs``
+    merged over them.  Scene, starts and reward kwargs of the training config are not
+    taken.  Returns a new dict."""
+    trained = (cfg or {}).get("env_kwargs") or {}
+    if not isinstance(trained, dict):
+        raise ValueError(f"the model config's env_kwargs must be a mapping, got {trained!r}")
+    out = {k: trained[k] for k in OBSERVATION_KWARGS if k in trained}
+    out.update(env_kwargs or {})
+    return out
+
+
 def policy_label(spec: str) -> str:
     """A short display name for a policy spec."""
     if spec in ("oracle", "random"):

@@ -24,7 +24,9 @@ scene_pool_size : int, default 64 -- scenes in the ``"random"`` pool.
 scene_pool_seed : int, default 0 -- the pool's seed (disjoint seeds: disjoint splits).
 min_start_distance : float | None, default None (0, or the ``difficulty``'s) -- a difficulty
     knob for ``scene="random"``: pool scenes whose start lies closer than this fraction of the
-    scene diameter to the recognizable region are re-drawn (Navigate, Recognize).
+    scene diameter to the recognizable region are re-drawn (Navigate, Recognize); with
+    ``random_start=True`` every drawn start keeps this distance too (any scene; the scene's
+    start when none is found).
 family : str | geometry.families.SceneFamily | None -- with ``scene="random"``, draw the pool
     from this scene family (``"easy"``, ``"medium"``, ``"hard"`` or a ``SceneFamily``) instead
     of :func:`geometry.generate.random_scene` (the default, unchanged).
@@ -613,9 +615,22 @@ class RobotBatch(SensorPlanBatch):
         for _ in range(10_000):
             x = rng.uniform(w.lo[0], w.hi[0])
             y = rng.uniform(w.lo[1], w.hi[1])
-            if shapely.contains_xy(space, x, y) and not w.in_region(x, y):
+            if (
+                shapely.contains_xy(space, x, y)
+                and not w.in_region(x, y)
+                and self.far_enough(i, x, y)
+            ):
                 return (float(x), float(y), float(rng.uniform(-math.pi, math.pi)))
-        return tuple(float(v) for v in self.starts[i])  # a region covering nearly all free space
+        # a region covering nearly all free space: the scene's (checked) start
+        return tuple(float(v) for v in self.starts[i])
+
+    def far_enough(self, i: int, x: float, y: float) -> bool:
+        """Whether ``(x, y)`` is at least ``min_start_distance`` scene diameters from the
+        recognizable region of sub-environment ``i`` (always, when that is 0)."""
+        if self.min_start_distance <= 0:
+            return True
+        w = self.worlds[i]
+        return w.distance_to_region(float(x), float(y)) >= self.min_start_distance * w.diameter
 
     def set_pose(self, i: int, pose) -> None:
         self.x[i], self.y[i], self.psi[i] = (float(v) for v in pose)

@@ -177,6 +177,7 @@ class RecognizeBatch(RobotBatch):
                 shapely.contains_xy(space, x, y)
                 and not w.in_region(x, y)
                 and not shapely.contains_xy(keep, x, y)
+                and self.far_enough(i, x, y)
             ):
                 self.set_pose(i, (x, y, float(rng.uniform(-math.pi, math.pi))))
                 return

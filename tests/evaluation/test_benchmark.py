@@ -60,3 +60,76 @@ def test_benchmark_writes_one_table(tmp_path):
     saved = json.loads((tmp_path / "benchmark.json").read_text())
     assert saved["difficulty"]["min_start_distance"] == 0.35
     assert (tmp_path / "benchmark.csv").read_text().count("\n") == 5
+
+
+def test_procedural_splits_draw_a_start_per_episode_and_count_distinct_episodes(tmp_path):
+    assert splits(["train", "test"], 0.3, needs_start=True)["test"]["random_start"] is True
+    assert "random_start" not in splits(["test"], 0.3, needs_start=False)["test"]
+    res = benchmark(
+        "sensorplan/Navigate-v0",
+        ["random"],
+        episodes=8,
+        split_names=["test", "ood:corridor"],
+        env_kwargs={"scene_pool_size": 4},
+        out=tmp_path,
+        verbose=False,
+    )
+    test, corridor = res["rows"]
+    # 4 pool scenes, 8 episodes: every episode has its own start
+    assert test["distinct_episodes"] == 8
+    # the bundled scene keeps its start: one distinct episode, however many are played
+    assert corridor["distinct_episodes"] == 1
+
+
+def test_wilson_interval_is_sized_by_distinct_episodes():
+    from agents.evaluation.evaluate import _summary
+    from agents.evaluation.stats import wilson_interval
+
+    ep = {
+        "success": [True, False] * 50,
+        "return": [0.0] * 100,
+        "steps": [1] * 100,
+        "path_length": [0.0] * 100,
+        "episode_key": [f"s{i % 10}" for i in range(100)],
+    }
+    s = _summary("p", "random", ep, {})
+    assert s["distinct_episodes"] == 10 and s["episodes"] == 100
+    assert s["success_ci95"] == list(wilson_interval(5, 10))
+    wide = s["success_ci95"][1] - s["success_ci95"][0]
+    lo, hi = wilson_interval(50, 100)
+    assert wide > hi - lo
+
+
+def _pool_fingerprint(env_id: str, kw: dict) -> list[tuple]:
+    env = gym.make(env_id, **kw)
+    src = env.unwrapped.batch.source
+    out = []
+    for k in range(src.size):
+        w, start = src.get(k)
+        out.append((round(w.region.area, 9), tuple(np.round(w.lo, 9)), tuple(np.round(w.hi, 9))))
+    env.close()
+    return out
+
+
+def test_train_split_is_the_training_pool():
+    from pathlib import Path
+
+    from agents.evaluation.benchmark import training_pool
+    from agents.learning.policies import model_config
+
+    shipped = Path(__file__).resolve().parents[2] / "agents" / "pretrained"
+    rec = str(shipped / "ppo_recognize_random.zip")
+    trained = model_config(rec)["env_kwargs"]
+    pool = training_pool(["oracle", rec])
+    assert pool["min_start_distance"] == trained["min_start_distance"]
+    sp = splits(["train", "test"], 0.35, needs_start=True, train_pool=pool)
+    env_id = "sensorplan/Recognize-v0"
+    train_kw = {k: trained[k] for k in ("scene", "min_start_distance", "max_scene_tries")}
+    assert _pool_fingerprint(env_id, sp["train"]) == _pool_fingerprint(env_id, train_kw)
+    # without a model trained on random scenes: the default pool of seed TRAIN_POOL_SEED
+    assert training_pool(["oracle", "random"]) is None
+    # models of different pools have no one training pool
+    nav = str(shipped / "ppo_navigate_random.zip")
+    if training_pool([nav]) != pool:
+        with pytest.raises(ValueError, match="different scene pools"):
+            training_pool([rec, nav])
