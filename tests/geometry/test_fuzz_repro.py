@@ -1,6 +1,7 @@
 """Regression tests from the independent fuzzer's shrunk reproductions (issues 25 and 26).
 
-Every file in ``/work/shared/fuzz-repro/`` (or ``$FUZZ_REPRO_DIR``) is one case: a scene
+Every file in ``tests/geometry/fuzz_repro/`` (a copy of the independent fuzzer's shrunk
+reproductions in ``shared/fuzz-repro/``; or ``$FUZZ_REPRO_DIR``) is one case: a scene
 JSON plus a ``.txt`` naming the call, the frame and what went wrong (or, for the issue-25
 files, the ``call``/``got`` keys inside the JSON).  Each case checks the property the
 report names, against an independent truth where the property is a point fact: the
@@ -25,7 +26,7 @@ from shapely.geometry import Point
 
 from geometry import Scene, complete_region, partial_region, recognizable_region
 
-REPRO = Path(os.environ.get("FUZZ_REPRO_DIR", "/work/shared/fuzz-repro"))
+REPRO = Path(os.environ.get("FUZZ_REPRO_DIR", Path(__file__).parent / "fuzz_repro"))
 
 pytestmark = pytest.mark.skipif(not REPRO.is_dir(), reason=f"no reproductions at {REPRO}")
 
