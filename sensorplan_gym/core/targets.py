@@ -42,33 +42,6 @@ NEED = 1 + 4 * TRIES
 BLOCK = 4 * NEED
 
 
-def _poly_distance(px, py, V, r, g, nv):
-    """Distance from ``(px, py)`` to the polygon ``V[r, g, :nv]`` (0 inside or on it)."""
-    best = math.inf
-    cross = 0
-    for k in range(nv):
-        kn = k + 1 if k + 1 < nv else 0
-        x1 = V[r, g, k, 0]
-        y1 = V[r, g, k, 1]
-        x2 = V[r, g, kn, 0]
-        y2 = V[r, g, kn, 1]
-        ex = x2 - x1
-        ey = y2 - y1
-        ax = px - x1
-        ay = py - y1
-        L2 = ex * ex + ey * ey
-        t = (ax * ex + ay * ey) / (L2 if L2 > 0.0 else 1.0)
-        t = max(min(t, 1.0), 0.0)
-        qx = ax - t * ex
-        qy = ay - t * ey
-        best = min(best, qx * qx + qy * qy)
-        if (y1 > py) != (y2 > py) and px < x1 + (py - y1) / (y2 - y1) * ex:
-            cross += 1
-    if cross % 2 == 1:
-        return 0.0
-    return math.sqrt(best)
-
-
 def place_targets(idx, U, uptr, P, radius, tri, cum, ntri, pts, tgt, nv, rot, H, nh, trows,
                   nstat, S, TS, side, poly):  # fmt: skip
     """Hide the target of rows ``idx`` (see the module docstring).
@@ -90,7 +63,7 @@ def place_targets(idx, U, uptr, P, radius, tri, cum, ntri, pts, tgt, nv, rot, H,
         side[i] = g + 1
         px = P[0, i]
         py = P[1, i]
-        far = _poly_distance(px, py, H, i, g, nh[i, g]) > lim
+        far = _dist_placed(px, py, H[i], g, nh[i, g]) > lim
         m = nv[i]
         qx = 0.0
         qy = 0.0
@@ -162,7 +135,8 @@ def place_targets(idx, U, uptr, P, radius, tri, cum, ntri, pts, tgt, nv, rot, H,
 
 
 def _dist_placed(px, py, poly, i, m):
-    """Distance from ``(px, py)`` to the placed target ``poly[i, :m]`` (0 inside)."""
+    """Distance from ``(px, py)`` to the polygon ``poly[i, :m]`` (0 inside): a placed target,
+    or a must-see hull ``H[r][g, :nh]``."""
     best = math.inf
     cross = 0
     for k in range(m):
@@ -201,7 +175,6 @@ def targets_clear(idx, P, radius, poly, nv, out):
 
 if HAVE_NUMBA:  # pragma: no cover - exercised when numba is installed
     _jit = numba.njit(cache=True, nogil=True, error_model="numpy")
-    _poly_distance = _jit(_poly_distance)
     _dist_placed = _jit(_dist_placed)
     place_targets = _jit(place_targets)
     targets_clear = _jit(targets_clear)
