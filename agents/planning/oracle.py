@@ -69,9 +69,20 @@ def _aim_for(world, p: np.ndarray) -> tuple[float, float]:
 
 def _aim_feasible_region(world, region: shapely.Geometry, n: int = 24) -> shapely.Geometry:
     """The part of ``region`` where one aim satisfies the field of view, approximated from
-    inside by the cells of an ``n x n`` grid whose four corners all pass the exact check."""
+    inside by the cells of an ``n x n`` grid over its bounding box whose four corners all
+    pass the exact check; the grid is refined (2n, 4n, 8n) while that finds no cell, since a
+    thin region in a large box can fall between the corners of a coarse one."""
     if world.fov >= 2 * math.pi - 1e-12 and math.isinf(world.max_range):
         return region
+    for k in (n, 2 * n, 4 * n, 8 * n):
+        cells = _aim_feasible_cells(world, region, k)
+        if not cells.is_empty:
+            return cells
+    return cells
+
+
+def _aim_feasible_cells(world, region: shapely.Geometry, n: int) -> shapely.Geometry:
+    """:func:`_aim_feasible_region` on one ``n x n`` grid (empty when no cell passes)."""
     x0, y0, x1, y1 = region.bounds
     xs = np.linspace(x0, x1, n + 1)
     ys = np.linspace(y0, y1, n + 1)

@@ -43,13 +43,6 @@ def test_oracle_solves_navigate_in_the_difficulty(name):
         assert level.family.contains(scene_parameters(env.unwrapped.world.scene))
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="oracle (agents.planning.oracle._aim_feasible_region) tests aims on a 24x24 grid "
-    "over the region's bounding box with all four cell corners passing: on hard scenes "
-    "(large rooms, narrow field of view, limited range) it finds no placement where most "
-    "of the region recognizes (issue 22 item 7)",
-)
 def test_oracle_finds_a_placement_on_hard_scenes():
     env = gym.make(NAV, scene="random", difficulty="hard", scene_pool_size=4)
     world, start = env.unwrapped.batch.source.get(3)
@@ -61,7 +54,9 @@ def test_oracle_finds_a_placement_on_hard_scenes():
     aims = np.linspace(-np.pi, np.pi, 72, endpoint=False)
     good = sum(any(world.recognizing(x, y, a) for a in aims) for x, y in pts)
     assert good > len(pts) / 2  # most of the region has a recognizing aim ...
-    assert plan_viewpoint(world, start[:2]).status == "ok"  # ... the oracle finds none
+    # ... and the oracle finds a placement (a coarse aim grid alone found none: the region
+    # is thin in a large bounding box)
+    assert plan_viewpoint(world, start[:2]).status == "ok"
 
 
 def test_pool_scenes_lie_in_the_family_and_far_enough():
