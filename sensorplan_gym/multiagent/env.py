@@ -25,6 +25,10 @@ Observation (per watcher, ``Box`` float32, length ``8 + 4 n_beams + 3 + 2 (n_wat
     move_steps``: a constant of the task, not of the outcome), the watcher's own declaration
     (0 none, -1 G, +1 H), and the other watchers' positions in its frame / diameter.  A's
     pose and outcome are never part of it: A shows only through the beams it reflects.
+    ``evidence=True`` appends 4 entries in [0, 1): what the watcher's own beams have shown
+    of A since A's plan is over, ``(seen_G, seen_H, looked_G, looked_H)``
+    (:mod:`sensorplan_gym.multiagent.evidence`: saturating counts of the steps on which a
+    short beam ended in ``A (+) G`` / ``A (+) H``, and on which a beam crossed them).
 Reward (``reward="individual"``, default)
     ``see_reward`` (default 0.01) on every step at whose end the watcher *sees* A under the
     configured model (:meth:`WatchWorld.sees`: exact, from the geometry, with the field of
@@ -46,7 +50,7 @@ Keyword arguments: ``scene`` (bundled name, JSON path, dict or Scene), ``n_watch
 (range std), ``robot_radius`` (0), ``max_speed`` (None: 3% of the diameter per step),
 ``max_turn`` (pi/8), ``max_steps`` (100), ``move_steps`` (50), ``p_fail`` (0.5),
 ``drift`` (0.02 of the diameter), ``speed_noise`` (0.2), ``reward``, ``see_reward``,
-``random_start`` (True: watchers start at seeded uniform free positions; False: watcher 0 at
+``evidence`` (False), ``random_start`` (True: watchers start at seeded uniform free positions; False: watcher 0 at
 the scene's ``start``, the others at fixed positions), ``render_mode`` (None/"rgb_array").
 The sensor has no placement/aim uncertainty here (``eps_pos``/``eps_aim`` are not modelled).
 """
@@ -63,6 +67,7 @@ from gymnasium.utils import seeding
 
 from ..core.sensor import RangeSensor, Segments, cast_rays
 from ..core.world import load_scene, sweep
+from .evidence import N_EVIDENCE, BeamEvidence
 from .motion import MotionConfig, Trajectory, plan_trajectory
 from .rendering import WatchRenderer
 from .world import WatchConfig, WatchWorld, get_watch_world
@@ -122,6 +127,7 @@ class WatchParallelEnv(_Base):
         see_reward: float = 0.01,
         random_start: bool = True,
         render_mode: str | None = None,
+        evidence: bool = False,
     ) -> None:
         if not isinstance(n_watchers, (int, np.integer)) or n_watchers < 1:
             raise ValueError(f"n_watchers must be a positive integer, got {n_watchers!r}")
@@ -145,6 +151,8 @@ class WatchParallelEnv(_Base):
                 raise ValueError(f"{name} must be a positive number, got {v!r}")
         if not isinstance(random_start, bool):
             raise ValueError(f"random_start must be True or False, got {random_start!r}")
+        if not isinstance(evidence, bool):
+            raise ValueError(f"evidence must be True or False, got {evidence!r}")
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"render_mode must be None or 'rgb_array', got {render_mode!r}")
         for name, v in (("fov_deg", fov_deg), ("max_range", max_range)):
@@ -186,7 +194,8 @@ class WatchParallelEnv(_Base):
         )
         shapely.prepare(self._robot_space)
         n = self.n_beams
-        k = 8 + 4 * n + 3 + 2 * (self.n_watchers - 1)
+        n_ev = N_EVIDENCE if evidence else 0
+        k = 8 + 4 * n + 3 + 2 * (self.n_watchers - 1) + n_ev
         low = np.concatenate(
             [
                 -np.ones(8),
@@ -195,6 +204,7 @@ class WatchParallelEnv(_Base):
                 np.zeros(n),
                 [0, 0, -1],
                 -np.ones(2 * (self.n_watchers - 1)),
+                np.zeros(n_ev),
             ]
         ).astype(np.float32)
         high = np.ones(k, dtype=np.float32)
@@ -216,6 +226,11 @@ class WatchParallelEnv(_Base):
         self._hc = np.asarray(w.failure_geom.centroid.coords[0], dtype=np.float64)
         span = w.hi - w.lo
         self._obs_consts = (float(w.lo[0]), float(w.lo[1]), 2.0 / span[0], 2.0 / span[1])
+        self.evidence = (
+            BeamEvidence(w.swept, self.n_watchers, 3 * self.noise + 1e-3 * w.reach)
+            if evidence
+            else None
+        )
 
     # ---- PettingZoo API --------------------------------------------------------------------
     def observation_space(self, agent: str) -> spaces.Box:
@@ -244,6 +259,8 @@ class WatchParallelEnv(_Base):
         self.seen_steps = [0] * self.n_watchers
         self.team_seen_steps = 0
         self.trail = [self.traj.at(0).copy()]
+        if self.evidence is not None:
+            self.evidence.reset()
         self._sense()
         obs = {a: self._observe(i) for i, a in enumerate(self.agents)}
         infos = {a: self._info(i) for i, a in enumerate(self.agents)}
@@ -411,6 +428,9 @@ class WatchParallelEnv(_Base):
                 self._memo[i] = (key, pred, sees)
             self.predicted.append(pred)
             self.sees.append(sees)
+            if self.evidence is not None and self.t >= self.move_steps:
+                ang = self.sensor.beam_angles(pose[2])
+                self.evidence.update(i, pose, ang, self.scans[i][0], pred)
 
     def _observe(self, i: int) -> np.ndarray:
         w = self.world
@@ -440,6 +460,8 @@ class WatchParallelEnv(_Base):
             [self.t / self.max_steps, float(self.t >= self.move_steps), dec],
             *others,
         ]
+        if self.evidence is not None:
+            parts.append(self.evidence.features(i))
         o = np.concatenate(parts).astype(np.float32)
         return np.clip(o, self._obs_space.low, self._obs_space.high)
 
