@@ -292,7 +292,11 @@ def build_parser() -> argparse.ArgumentParser:
         "expert, optionally followed by PPO fine-tuning; hyperparameters from "
         "agents/configs/imitation.yaml (see agents/learning/imitation.py).",
     )
-    im.add_argument("--env", required=True, help=ENV_CHOICES_HELP)
+    im.add_argument(
+        "--env",
+        required=True,
+        help=ENV_CHOICES_HELP + "; watch_v0: the watchers (agents/configs/watch_imitation.yaml)",
+    )
     im.add_argument("--method", default="dagger", choices=("bc", "dagger", "dagger+ppo", "ppo"))
     im.add_argument("--seed", type=int, default=0)
     im.add_argument("--config", default=None, help="YAML (default agents/configs/imitation.yaml)")
@@ -460,6 +464,20 @@ def main(argv: list[str] | None = None) -> int:
                 overwrite=args.overwrite,
             )
             print(f"{args.dataset_id}: {ds.total_episodes} episodes, {ds.total_steps} steps")
+            return 0
+        if args.command == "imitate" and args.env == "watch_v0":
+            from .learning.watch_imitation import train_watch_imitation
+
+            if args.method != "dagger":
+                raise ValueError(f"--env watch_v0 learns by --method dagger, got {args.method!r}")
+            rec = train_watch_imitation(
+                args.config,
+                seed=args.seed,
+                out=args.out,
+                wall_s=args.wall_s,
+                overrides=args.overrides,
+            )
+            print(f"policy: {rec['out']}/final_model.pt  ({rec['wall_time_s']} s)")
             return 0
         if args.command == "imitate":
             from .learning.imitation import train_imitation
