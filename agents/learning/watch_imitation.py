@@ -43,6 +43,8 @@ import torch
 import yaml
 from stable_baselines3.common.policies import ActorCriticPolicy
 
+from sensorplan_gym.multiagent.evidence import N_EVIDENCE
+
 from ..planning.watch_expert import WatchExpert
 from .imitation import _plain, fit
 from .train import _activation
@@ -65,7 +67,8 @@ TRAIN_SEED_BASE = 10_000_000  # training episodes' seeds (evaluation uses 1,000,
 def load_config(config: str | Path | dict | None = None) -> dict[str, Any]:
     """The training config: a YAML file (default :data:`CONFIG`), a resolved
     ``final_model.yaml`` (its ``config`` section) or a dict (copied).  Keys: ``env_kwargs``,
-    ``placement``, ``decide_window``, ``n_envs``, ``policy_kwargs``, ``dagger``."""
+    ``placement``, ``decide_window``, ``n_envs``, ``policy_kwargs``, ``dagger``,
+    ``mask_evidence`` (the ablation: the learner never sees the evidence entries)."""
     if isinstance(config, dict):
         cfg = copy.deepcopy(config)
     else:
@@ -114,13 +117,16 @@ def collect_watch(
     *,
     beta: float = 1.0,
     rng: np.random.Generator | None = None,
+    mask_evidence: bool = False,
 ) -> tuple[np.ndarray, np.ndarray, dict[str, float]]:
     """Play one episode per env (``envs[j]`` reset with ``seeds[j]``), all in lock step.  On
     every step each watcher follows its teacher with probability ``beta`` and ``policy``
     (deterministic) otherwise; every visited observation is recorded with the teacher's
     action there.  Returns ``(observations (k, d), teacher actions (k, 4), stats)``, stats =
     ``episodes``, ``watcher_success`` (fraction of watchers right), ``visible`` (mean
-    per-watcher fraction of steps A was seen), ``expert_fraction``."""
+    per-watcher fraction of steps A was seen), ``expert_fraction``.  ``mask_evidence``: the
+    learner sees (and the data set records) zeros in place of the evidence entries (an
+    ablation; the teacher still declares from the evidence)."""
     if not 0.0 <= beta <= 1.0:
         raise ValueError(f"beta must be in [0, 1], got {beta!r}")
     if policy is None and beta < 1.0:
@@ -136,6 +142,8 @@ def collect_watch(
         agents = [list(o) for o in obs]
         labels = [ex.act(o) for ex, o in zip(experts, obs, strict=True)]
         X = np.stack([o[a] for o, ag in zip(obs, agents, strict=True) for a in ag])
+        if mask_evidence:
+            X[:, -N_EVIDENCE:] = 0.0
         Y = np.stack([lab[a] for lab, ag in zip(labels, agents, strict=True) for a in ag])
         use = rng.random(len(X)) < beta
         A = Y if use.all() else np.where(use[:, None], Y, _act(policy, X))
@@ -176,13 +184,15 @@ def dagger_watch(
     learning_rate: float = 1e-3,
     seed: int = 0,
     deadline: float | None = None,
+    mask_evidence: bool = False,
     log=None,
 ) -> list[dict[str, Any]]:
     """DAgger: ``iterations`` rounds of :func:`collect_watch` (``episodes`` per round, in
     batches of ``n_envs`` envs, ``beta_i = beta0 * decay ** i``), aggregation of all pairs
     so far and :func:`agents.learning.imitation.fit` of ``policy``.  Training episodes are
     seeded ``10,000,000 + 100,000 seed + k`` (never the evaluation seeds).  ``deadline``
-    (``time.perf_counter()``): stop after the round that passes it.  Returns the per-round
+    (``time.perf_counter()``): stop after the round that passes it; ``mask_evidence``: as in
+    :func:`collect_watch`.  Returns the per-round
     history (beta, pairs, the round's per-watcher success and visible fraction, loss, s)."""
     if iterations < 1 or episodes < 1 or n_envs < 1:
         raise ValueError("dagger_watch: iterations, episodes and n_envs must be positive")
@@ -201,7 +211,15 @@ def dagger_watch(
         while done < episodes:
             m = min(len(envs), episodes - done)
             seeds = [TRAIN_SEED_BASE + 100_000 * seed + ep + j for j in range(m)]
-            x, y, s = collect_watch(envs[:m], experts[:m], policy, seeds, beta=beta, rng=rng)
+            x, y, s = collect_watch(
+                envs[:m],
+                experts[:m],
+                policy,
+                seeds,
+                beta=beta,
+                rng=rng,
+                mask_evidence=mask_evidence,
+            )
             xs.append(x)
             ys.append(y)
             st.append(s)
@@ -282,6 +300,7 @@ def train_watch_imitation(
         learning_rate=float(d.get("learning_rate", 1e-3)),
         seed=seed,
         deadline=None if wall_s is None else t0 + float(wall_s),
+        mask_evidence=bool(cfg.get("mask_evidence", False)),
         log=print if verbose else None,
     )
     record = {
@@ -324,6 +343,7 @@ class WatchImitationPolicy:
         self.path = str(p.resolve())
         self.record = yaml.safe_load(y.read_text())
         self.env_kwargs = {**self.record["config"]["env_kwargs"], "evidence": True}
+        self.mask_evidence = bool(self.record["config"].get("mask_evidence", False))
         self._policy = None
 
     def __getstate__(self) -> dict:
@@ -340,7 +360,10 @@ class WatchImitationPolicy:
         agents = list(observations)
         if not agents:
             return {}
-        a = _act(self._policy, np.stack([observations[k] for k in agents]))
+        x = np.stack([observations[k] for k in agents])
+        if self.mask_evidence:  # trained blind to the evidence (the ablation)
+            x[:, -N_EVIDENCE:] = 0.0
+        a = _act(self._policy, x)
         return {k: a[i] for i, k in enumerate(agents)}
 
 
