@@ -77,3 +77,16 @@ def test_saved_policy_acts_as_trained_and_collect_checks(tmp_path):
         collect_watch([env, env], [ex], None, [0, 1])
     with pytest.raises(FileNotFoundError):
         WatchImitationPolicy(tmp_path / "nope.pt")
+
+
+def test_cli_imitate_watch_v0(tmp_path):
+    from agents.cli import main
+
+    tiny = (
+        '{"n_envs": 1, "policy_kwargs": {"net_arch": [8]}, '
+        '"dagger": {"iterations": 1, "episodes": 1, "epochs": 1}}'
+    )
+    args = ["imitate", "--env", "watch_v0", "--out", str(tmp_path), "--overrides", tiny]
+    assert main(args) == 0
+    assert (tmp_path / "final_model.pt").is_file() and (tmp_path / "final_model.yaml").is_file()
+    assert main(["imitate", "--env", "watch_v0", "--method", "bc", "--out", str(tmp_path)]) == 2
