@@ -43,6 +43,7 @@ NAMES = (
     "swept_accuracy",
     "viewer_layers",
     "watch_oracle",
+    "watch_declare",
     "watch_throughput",
     "reference",
 )

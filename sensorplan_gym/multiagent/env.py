@@ -50,8 +50,9 @@ Keyword arguments: ``scene`` (bundled name, JSON path, dict or Scene), ``n_watch
 (range std), ``robot_radius`` (0), ``max_speed`` (None: 3% of the diameter per step),
 ``max_turn`` (pi/8), ``max_steps`` (100), ``move_steps`` (50), ``p_fail`` (0.5),
 ``drift`` (0.02 of the diameter), ``speed_noise`` (0.2), ``reward``, ``see_reward``,
-``evidence`` (False), ``random_start`` (True: watchers start at seeded uniform free positions; False: watcher 0 at
-the scene's ``start``, the others at fixed positions), ``render_mode`` (None/"rgb_array").
+``random_start`` (True: watchers start at seeded uniform free positions; False: watcher 0 at
+the scene's ``start``, the others at fixed positions), ``render_mode`` (None/"rgb_array"),
+``evidence`` (False).
 The sensor has no placement/aim uncertainty here (``eps_pos``/``eps_aim`` are not modelled).
 """
 
