@@ -8,7 +8,7 @@ watch oracle with the beam-evidence observation), the oracle watchers and unifor
 actions, on the env the policy was trained on (lab, 2 watchers, ``evidence=True``) and the same
 episode seeds (1,000,000 + seed onwards): per-watcher declaration accuracy, the fraction of
 steps each watcher (and the team) saw A, and the episodes in which every watcher was right,
-each with a 95 % bootstrap interval over episodes
+each with a 95 % interval over episodes
 (:func:`agents.evaluation.watch_declare.summarize`).  The data (``watch_declare.json``,
 without the per-episode lists) and the page fragment go to ``--out`` (default
 ``runs/benchmarks/watch_declare/``), or with ``--update-results`` to
@@ -82,7 +82,8 @@ def render(data: dict[str, Any]) -> str:
         "",
         f"`{data['command']}`: `{data['policy']}` on scene `{kw['scene']}` with "
         f"{kw['n_watchers']} watchers, {data['episodes']} episodes (seeds "
-        f"{EVAL_SEED_BASE + data['seed']:,} onwards), 95 % bootstrap intervals over episodes; "
+        f"{EVAL_SEED_BASE + data['seed']:,} onwards), 95 % intervals over episodes (Wilson for "
+        "the rates, bootstrap for the view); "
         f"{data['seconds']:,.0f} s on {m['cpus']} CPUs (load average {m['load_average']}). "
         f"Trained by `{data['training_command']}` in {data['training_s']:,.0f} s.",
     ]

@@ -11,9 +11,11 @@ seeds (``1,000,000 + seed + i``, as every evaluation here) with
 declaration accuracy (the fraction of watchers that declared A's end region right; a
 watcher that never declares is wrong), the fraction of steps each watcher saw A, the
 fraction on which some watcher did, and the episodes in which every watcher was right --
-each a mean over episodes with a 95 % percentile bootstrap interval over episodes
-(:func:`agents.evaluation.stats.stratified_bootstrap_ci`, the statistic the mean; episodes
-are the independent units, the watchers of an episode are not).
+each a mean over episodes with a 95 % interval that takes episodes as the independent units
+(the watchers of an episode are not): for the two rates a Wilson interval of the effective
+count ``mean * episodes`` out of ``episodes`` (:func:`agents.evaluation.stats.wilson_interval`;
+it stays informative at 100 %), for the two view fractions a percentile bootstrap over
+episodes (:func:`agents.evaluation.stats.stratified_bootstrap_ci`, the statistic the mean).
 """
 
 from __future__ import annotations
@@ -29,12 +31,13 @@ import numpy as np
 from ..checks import check_writable_file
 from ..learning.watch_imitation import WatchImitationPolicy
 from .episodes import EVAL_SEED_BASE
-from .stats import stratified_bootstrap_ci
+from .stats import stratified_bootstrap_ci, wilson_interval
 from .watch import run_watch_episodes
 
-__all__ = ["METRICS", "compare_with_oracle", "format_table", "main", "summarize"]
+__all__ = ["METRICS", "RATES", "compare_with_oracle", "format_table", "main", "summarize"]
 
-# summary name -> run_watch_episodes key
+# summary name -> run_watch_episodes key (RATES get a Wilson interval, the rest a bootstrap one)
+RATES = ("per_watcher_right", "all_right")
 METRICS = {
     "per_watcher_right": "watcher_success",
     "visible_per_watcher": "visible",
@@ -45,12 +48,18 @@ METRICS = {
 
 def summarize(ep: dict[str, list], *, seed: int = 0) -> dict[str, Any]:
     """Per metric of :data:`METRICS`: ``[mean, ci_low, ci_high]`` over the episodes of
-    ``ep`` (a :func:`run_watch_episodes` result), 2000 bootstrap replicates."""
-    out: dict[str, Any] = {"episodes": len(ep["seed"])}
+    ``ep`` (a :func:`run_watch_episodes` result): Wilson for :data:`RATES`, 2000 bootstrap
+    replicates (seeded ``seed``) for the view fractions."""
+    n = len(ep["seed"])
+    out: dict[str, Any] = {"episodes": n}
     for name, key in METRICS.items():
         x = np.asarray(ep[key], dtype=float)
-        est, lo, hi = stratified_bootstrap_ci(x, statistic=np.mean, seed=seed)
-        out[name] = [est, lo, hi]
+        if name in RATES:
+            est = float(x.mean())
+            lo, hi = wilson_interval(est * n, n)
+            out[name] = [est, float(min(lo, est)), float(max(hi, est))]
+        else:
+            out[name] = list(stratified_bootstrap_ci(x, statistic=np.mean, seed=seed))
     return out
 
 
@@ -92,8 +101,8 @@ def format_table(res: dict[str, Any]) -> str:
     lines.append("")
     lines.append(
         f"{res['learned']['episodes']} episodes (seeds {res['seeds'][0]:,}..{res['seeds'][1]:,}),"
-        f" scene {kw.get('scene')!r}, {kw.get('n_watchers', 1)} watchers; 95 % bootstrap "
-        "intervals over episodes."
+        f" scene {kw.get('scene')!r}, {kw.get('n_watchers', 1)} watchers; 95 % intervals over "
+        "episodes (Wilson for the rates, bootstrap for the view)."
     )
     return "\n".join(lines)
 

@@ -10,7 +10,8 @@ import pytest
 
 pytest.importorskip("stable_baselines3")
 
-from agents.evaluation.watch_declare import METRICS, main, summarize  # noqa: E402
+from agents.evaluation.stats import wilson_interval  # noqa: E402
+from agents.evaluation.watch_declare import METRICS, RATES, main, summarize  # noqa: E402
 from agents.learning.watch_imitation import train_watch_imitation  # noqa: E402
 
 CFG = {
@@ -37,6 +38,11 @@ def test_summarize_means_and_intervals():
         est, lo, hi = s[name]
         assert est == pytest.approx(np.mean(np.asarray(ep[key], dtype=float)))
         assert lo < est < hi and hi - lo < 0.5
+        if name in RATES:
+            assert (lo, hi) == pytest.approx(wilson_interval(est * 50, 50))
+    # all right: the Wilson interval stays informative where a bootstrap collapses to a point
+    perfect = summarize({**ep, "watcher_success": [1.0] * 50})["per_watcher_right"]
+    assert perfect[0] == 1.0 and perfect[1] < 0.95 and perfect[2] == 1.0
 
 
 def test_cli_compares_with_the_oracle(tmp_path, capsys):
