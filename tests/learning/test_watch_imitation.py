@@ -90,3 +90,18 @@ def test_cli_imitate_watch_v0(tmp_path):
     assert main(args) == 0
     assert (tmp_path / "final_model.pt").is_file() and (tmp_path / "final_model.yaml").is_file()
     assert main(["imitate", "--env", "watch_v0", "--method", "bc", "--out", str(tmp_path)]) == 2
+
+
+def test_shipped_team_is_the_current_config_and_declares():
+    """agents/pretrained/dagger_watch_lab2.pt: trained with today's config file, and on a few
+    evaluation episodes every watcher declares right (the full measurement is
+    benchmarks/watch_declare.py)."""
+    from pathlib import Path
+
+    from agents.learning.watch_imitation import load_config
+
+    shipped = Path(__file__).resolve().parents[2] / "agents/pretrained/dagger_watch_lab2.pt"
+    pol = WatchImitationPolicy(shipped)
+    assert pol.record["config"] == load_config()
+    ep = run_watch_episodes(pol.env_kwargs, pol, SEEDS[:4])
+    assert np.mean(ep["watcher_success"]) == 1.0, ep
