@@ -7,8 +7,9 @@ team) saw A; :func:`evaluate_watch` does so for every scene and watcher count, l
 Ray workers, with the same episode seeds as :mod:`agents.evaluation.evaluate`.
 
 ``python -m agents.evaluation.watch --scenes lab edr corridor warehouse --watchers 1 2
---episodes 200 [--backend ray] [--policy oracle|random|RLLIB_CHECKPOINT]`` prints the table in
-the README.
+--episodes 200 [--backend ray] [--policy oracle|random|RLLIB_CHECKPOINT|TEAM.pt]`` prints the
+table in the README (``TEAM.pt``: a team of :mod:`agents.learning.watch_imitation`, played on
+``evidence=True`` envs).
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ import numpy as np
 
 from ..checks import check_writable_file, missing_extra_message
 from ..learning.rllib_train import RLlibWatchPolicy
+from ..learning.watch_imitation import WatchImitationPolicy
 from ..planning.watch_oracle import WatchOracle
 from .episodes import EVAL_SEED_BASE
 from .ray_eval import map_chunks
@@ -173,7 +175,11 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="python -m agents.evaluation.watch", description=__doc__)
     ap.add_argument("--scenes", nargs="+", default=list(BUNDLED_SCENES))
     ap.add_argument("--watchers", nargs="+", type=int, default=[1, 2])
-    ap.add_argument("--policy", default="oracle", help="oracle, random or an RLlib checkpoint")
+    ap.add_argument(
+        "--policy",
+        default="oracle",
+        help="oracle, random, an RLlib checkpoint or a watch_imitation .pt (adds evidence=True)",
+    )
     ap.add_argument("--episodes", type=int, default=100)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--env-kwargs", type=json.loads, default=None)
@@ -185,7 +191,11 @@ def main(argv: list[str] | None = None) -> int:
         if args.json:
             check_writable_file(args.json, what="--json")
         policy: Any = args.policy
-        if policy not in ("oracle", "random"):
+        env_kwargs = args.env_kwargs
+        if policy.endswith(".pt"):  # a watcher team of agents.learning.watch_imitation
+            policy = WatchImitationPolicy(policy)
+            env_kwargs = {**(env_kwargs or {}), "evidence": True}
+        elif policy not in ("oracle", "random"):
             policy = RLlibWatchPolicy(policy)  # a relative checkpoint path is made absolute
         rows = evaluate_watch(
             args.scenes,
@@ -193,7 +203,7 @@ def main(argv: list[str] | None = None) -> int:
             policy=policy,
             episodes=args.episodes,
             seed=args.seed,
-            env_kwargs=args.env_kwargs,
+            env_kwargs=env_kwargs,
             backend=args.backend,
             address=args.address,
         )

@@ -90,8 +90,16 @@ class BeamEvidence:
         self.hits[:] = 0
         self.looks[:] = 0
 
-    def update(self, i: int, pose, angles, measured, predicted) -> None:
-        """Count watcher ``i``'s readings of this step (call only once A's plan is over)."""
+    def update(
+        self,
+        i: int,
+        pose: tuple[float, float, float],
+        angles: np.ndarray,
+        measured: np.ndarray,
+        predicted: np.ndarray,
+    ) -> None:
+        """Count watcher ``i``'s readings of this step (call only once A's plan is over);
+        arguments as :func:`beam_evidence`."""
         hit, look = beam_evidence(self.swept, pose, angles, measured, predicted, self.tol)
         self.hits[i] += hit
         self.looks[i] += look

@@ -58,3 +58,14 @@ def test_cli_compares_with_the_oracle(tmp_path, capsys):
     assert res["per_episode"]["learned"]["seed"] == res["per_episode"]["oracle"]["seed"]
     assert main(["--policy", str(tmp_path / "final_model.pt"), "--episodes", "0"]) == 2
     assert main(["--policy", str(tmp_path / "missing.pt")]) == 2
+
+
+def test_watch_cli_plays_a_watch_imitation_team(capsys):
+    from pathlib import Path
+
+    from agents.evaluation.watch import main as watch_main
+
+    team = Path(__file__).resolve().parents[2] / "agents/pretrained/dagger_watch_lab2.pt"
+    args = ["--scenes", "lab", "--watchers", "2", "--episodes", "2", "--policy", str(team)]
+    assert watch_main(args) == 0
+    assert "lab               2" in capsys.readouterr().out
