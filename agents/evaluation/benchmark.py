@@ -1,7 +1,8 @@
 """The benchmark protocol: every policy on named scene splits, one table.
 
 ``sensorplan benchmark --env ID --policies oracle random model.zip ... [--episodes N]
-[--difficulty D] [--splits train test ood] [--env-kwargs JSON] [--out DIR]``
+[--difficulty D] [--level easy|medium|hard] [--splits train test ood] [--env-kwargs JSON]
+[--out DIR]``
 
 Splits (each an env-kwargs override on top of ``--env-kwargs``):
 
@@ -24,6 +25,11 @@ recognizable region (Navigate, Recognize; Placement has no start).  It is report
 result, with the measured mean start distance of the scenes played.  At the default the random
 policy succeeds in about 0.2 of Navigate-v0's test episodes (measured with 64 batched
 envs over 1,000 steps: 0.22 at ``D = 0.35``, 0.83 at ``D = 0``).
+
+The benchmark levels ``--level easy|medium|hard`` (:data:`geometry.families.DIFFICULTIES`)
+draw the procedural splits from the level's scene family (field of view, range, room shapes,
+clutter, G/H kinds, targets) at the level's ``min_start_distance`` (unless ``--difficulty``
+is given); the bundled scenes are played as they are.
 
 Per split and policy: what :func:`agents.evaluation.evaluate.evaluate` reports (success with
 its Wilson interval, return, steps, path length, normalized score; IQM over training seeds).  Writes
@@ -62,9 +68,11 @@ DEFAULT_DIFFICULTY = 0.35
 POOL_KWARGS = {
     "scene_pool_seed": TRAIN_POOL_SEED,
     "scene_pool_size": 64,
-    "min_start_distance": 0.0,
+    "min_start_distance": None,
     "max_scene_tries": 25,
     "random_scene_kwargs": None,
+    "family": None,
+    "difficulty": None,
 }
 
 
@@ -94,19 +102,27 @@ def training_pool(policies: list[str]) -> dict | None:
 
 
 def splits(
-    names: list[str], difficulty: float, needs_start: bool, train_pool: dict | None = None
+    names: list[str],
+    difficulty: float | None,
+    needs_start: bool,
+    train_pool: dict | None = None,
+    level: str | None = None,
 ) -> dict[str, dict]:
     """Env-kwargs overrides of the named splits (``ood`` expands to one split per scene).
     ``train`` is ``train_pool`` (see :func:`training_pool`; its own ``min_start_distance``
     replaces ``difficulty``) when given, else the default pool of seed
-    :data:`TRAIN_POOL_SEED` at ``difficulty``."""
+    :data:`TRAIN_POOL_SEED` at ``difficulty``.  ``level`` (``"easy"``, ``"medium"``,
+    ``"hard"``: :data:`geometry.families.DIFFICULTIES`) draws the procedural splits from that
+    level's scene family, at its ``min_start_distance`` unless ``difficulty`` is given."""
     from sensorplan_gym import BUNDLED_SCENES
 
-    hard = (
-        {"min_start_distance": difficulty, "max_scene_tries": 200}
-        if needs_start and difficulty > 0
-        else {}
-    )
+    hard: dict = {}
+    if level is not None:
+        hard["difficulty"] = level
+    if needs_start and difficulty is not None and difficulty > 0:
+        hard.update(min_start_distance=difficulty)
+    if needs_start and (level is not None or "min_start_distance" in hard):
+        hard["max_scene_tries"] = 200
     if needs_start:  # a start drawn per episode: 100 episodes are not 64 scene-start pairs
         hard = {"random_start": True, **hard}
     out: dict[str, dict] = {}
@@ -153,8 +169,9 @@ def benchmark(
     *,
     episodes: int = 100,
     seed: int = 0,
-    difficulty: float = DEFAULT_DIFFICULTY,
+    difficulty: float | None = DEFAULT_DIFFICULTY,
     split_names: list[str] | None = None,
+    level: str | None = None,
     env_kwargs: dict | None = None,
     out: str | Path | None = None,
     verbose: bool = True,
@@ -167,6 +184,12 @@ def benchmark(
     import sensorplan_gym  # noqa: F401
 
     check_policies(policies)  # every path, before any episode is played
+    if level is not None:
+        from geometry.families import get_difficulty
+
+        lv = get_difficulty(level)  # a clear error for an unknown level, before any output
+        if difficulty is None:
+            difficulty = lv.min_start_distance
     out = check_writable_dir(
         out if out is not None else fresh_dir(Path("runs") / f"benchmark_{env_id.split('/')[-1]}")
     )
@@ -176,10 +199,13 @@ def benchmark(
     probe.close()
     names = split_names or ["train", "test", "ood"]
     pool = training_pool(policies) if "train" in names else None
-    sp = splits(names, difficulty, needs_start, train_pool=pool)
+    sp = splits(names, difficulty, needs_start, train_pool=pool, level=level)
     res: dict[str, Any] = {
         "env_id": env_id,
-        "difficulty": {"min_start_distance": difficulty if needs_start else None},
+        "difficulty": {
+            "min_start_distance": difficulty if needs_start else None,
+            "level": level,
+        },
         "episodes": episodes,
         "seed": seed,
         "deterministic": bool(deterministic),

@@ -133,3 +133,29 @@ def test_train_split_is_the_training_pool():
     if training_pool([nav]) != pool:
         with pytest.raises(ValueError, match="different scene pools"):
             training_pool([rec, nav])
+
+
+def test_level_draws_the_procedural_splits_from_its_family(tmp_path):
+    from geometry.families import get_difficulty
+
+    sp = splits(["train", "test", "ood:lab"], None, needs_start=True, level="hard")
+    assert sp["test"]["difficulty"] == sp["train"]["difficulty"] == "hard"
+    assert "difficulty" not in sp["ood:lab"]  # bundled scenes are what they are
+    # an explicit knob wins over the level's own start distance
+    assert splits(["test"], 0.5, True, level="hard")["test"]["min_start_distance"] == 0.5
+    env = gym.make("sensorplan/Navigate-v0", scene_pool_size=2, **sp["test"])
+    _, info = env.reset(seed=0)
+    d = info["distance_to_region"] / env.unwrapped.world.diameter
+    assert d >= get_difficulty("hard").min_start_distance
+    env.close()
+    with pytest.raises(ValueError, match="unknown difficulty 'nightmare'"):
+        benchmark(
+            "sensorplan/Navigate-v0",
+            ["random"],
+            episodes=1,
+            level="nightmare",
+            split_names=["test"],
+            out=tmp_path / "never",
+            verbose=False,
+        )
+    assert not (tmp_path / "never").exists()
