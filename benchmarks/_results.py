@@ -41,6 +41,7 @@ NAMES = (
     "scaling",
     "swept",
     "swept_accuracy",
+    "train_profile",
     "viewer_layers",
     "watch_oracle",
     "watch_throughput",
