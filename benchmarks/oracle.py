@@ -1,10 +1,13 @@
-"""Oracle success rates: ``python -m benchmarks.oracle [--episodes N] [--random-scenes M]``.
+"""Oracle success rates: ``python -m benchmarks.oracle [--episodes N] [--random-scenes M]
+[--levels easy medium hard] [--level-scenes K]``.
 
 For every environment, every bundled scene (N episodes each, evaluation seeds
 1_000_000 onwards) and M procedural scenes (``geometry.generate.random_scene``, one
 episode each).  A random scene whose recognizable region is empty, or not reachable
 from any start, has no recognizing placement: it is excluded from the rate and counted
-separately.  Prints the table and writes the data (``oracle.json``) and the page fragment
+separately.  For every benchmark level of ``--levels`` (:data:`geometry.families.DIFFICULTIES`),
+K scenes drawn from the level's family, one episode each from a random start at the level's
+``min_start_distance``.  Prints the table and writes the data (``oracle.json``) and the page fragment
 (``oracle.md``) to ``--out`` (default ``runs/benchmarks/oracle/``); with ``--update-results``
 the tracked ``benchmarks/results/oracle.json`` and ``docs/results/oracle.md`` instead.
 """
@@ -20,6 +23,7 @@ import numpy as np
 
 import sensorplan_gym  # noqa: F401
 from agents.planning.oracle import OraclePolicy
+from geometry.families import get_difficulty
 from geometry.generate import random_scene
 
 from . import _results
@@ -46,6 +50,14 @@ def main(argv: list[str] | None = None) -> None:
     )
     ap.add_argument("--episodes", type=int, default=100)
     ap.add_argument("--random-scenes", type=int, default=200)
+    ap.add_argument(
+        "--levels",
+        nargs="*",
+        default=["hard"],
+        choices=["easy", "medium", "hard"],
+        help="benchmark levels whose scene families are played (default: hard)",
+    )
+    ap.add_argument("--level-scenes", type=int, default=100, help="scenes per level")
     _results.add_output_args(ap, "oracle")
     args = ap.parse_args(argv)
     data: dict[str, Any] = {
@@ -53,6 +65,8 @@ def main(argv: list[str] | None = None) -> None:
         "machine": _results.machine(),
         "episodes": args.episodes,
         "random_scenes": args.random_scenes,
+        "levels": args.levels,
+        "level_scenes": args.level_scenes,
         "seed0": SEED0,
         "rows": [],
     }
@@ -107,10 +121,42 @@ def main(argv: list[str] | None = None) -> None:
             }
         )
         print(rows[-1], flush=True)
+        for level in args.levels:
+            data["rows"].append(_level_row(env_id, level, args.level_scenes))
+            print(data["rows"][-1], flush=True)
     table = "\n".join(rows)
     data["seconds"] = round(time.perf_counter() - t0, 1)
     print(f"\n{table}\n\n({data['seconds']:.0f} s)")
     _results.write("oracle", data, args.out, args.update_results)
+
+
+def _level_row(env_id: str, level: str, n: int) -> dict[str, Any]:
+    """One episode on each of ``n`` scenes of the level's family (scene seeds ``SEED0 +
+    i``), from a random start at the level's ``min_start_distance`` where the task has a
+    start."""
+    lv = get_difficulty(level)
+    wins = runs = excluded = 0
+    for i in range(n):
+        scene = lv.family.sample(np.random.default_rng(SEED0 + i))
+        kw: dict[str, Any] = {"scene": scene}
+        if env_id != "sensorplan/Placement-v0":
+            kw.update(random_start=True, min_start_distance=lv.min_start_distance)
+        try:
+            env = gym.make(env_id, **kw)
+        except ValueError as e:  # no recognizing placement reachable from a start
+            if "unusable" not in str(e):
+                raise
+            excluded += 1
+            continue
+        runs += 1
+        wins += episode(env, OraclePolicy(env), SEED0 + i)
+    return {
+        "env": env_id,
+        "scene": f"level:{level}",
+        "episodes": runs,
+        "successes": wins,
+        "excluded": excluded,
+    }
 
 
 def render(data: dict[str, Any]) -> str:
@@ -124,7 +170,11 @@ def render(data: dict[str, Any]) -> str:
     envs = list(dict.fromkeys(r["env"] for r in data["rows"]))
 
     def head(sc: str) -> str:
-        return f"{data['random_scenes']} random scenes" if sc == "random" else sc
+        if sc == "random":
+            return f"{data['random_scenes']} random scenes"
+        if sc.startswith("level:"):
+            return f"{data['level_scenes']} `{sc[6:]}` scenes"
+        return sc
 
     lines = [
         "| oracle success | " + " | ".join(head(sc) for sc in scenes) + " |",
@@ -138,7 +188,7 @@ def render(data: dict[str, Any]) -> str:
                 cells.append("")
                 continue
             c = f"{r['successes']}/{r['episodes']}"
-            if sc == "random":
+            if sc == "random" or sc.startswith("level:"):
                 c += f" ({r['excluded']} without a placement)"
             cells.append(c)
         lines.append(f"| {env.split('/')[-1]} | " + " | ".join(cells) + " |")
@@ -147,7 +197,15 @@ def render(data: dict[str, Any]) -> str:
         "",
         f"`{data['command']}`: {data['episodes']} episodes per bundled scene (seeds "
         f"{data['seed0']:,} onwards), one episode on each of {data['random_scenes']} procedural "
-        f"scenes; {data['seconds']:,.0f} s on {m['cpus']} CPUs (load average "
+        f"scenes"
+        + (
+            f" and on each of {data['level_scenes']} scenes of the "
+            + ", ".join(f"`{x}`" for x in data["levels"])
+            + " level's family (random starts at the level's start distance)"
+            if data.get("levels")
+            else ""
+        )
+        + f"; {data['seconds']:,.0f} s on {m['cpus']} CPUs (load average "
         f"{m['load_average']}).",
     ]
     return "\n".join(lines) + "\n"
