@@ -4,8 +4,10 @@ ROS occupancy-grid maps (issues 22 and 25: real floor plans of 100-300 edges).
 The maps are not shipped; get them from ros-planning/navigation_tutorials (BSD) at the
 commit recorded below, then::
 
-    git -C navigation_tutorials show 115e46ec9e65d49756b5d2155326ad2c1694d1e6:navigation_stage/stage_config/maps/willow-full.pgm > willow-full.pgm
-    git -C navigation_tutorials show 115e46ec9e65d49756b5d2155326ad2c1694d1e6:roomba_stage/maps/lse_arena.pgm > lse_arena.pgm
+    C=115e46ec9e65d49756b5d2155326ad2c1694d1e6
+    git -C navigation_tutorials show $C:navigation_stage/stage_config/maps/willow-full.pgm \
+        > willow-full.pgm
+    git -C navigation_tutorials show $C:roomba_stage/maps/lse_arena.pgm > lse_arena.pgm
     python -m benchmarks.make_real_maps --willow willow-full.pgm --lse lse_arena.pgm
 
 Each input's SHA-256 is checked against the recorded one, so the scenes are exactly
@@ -200,6 +202,7 @@ def build(name: str, pgm: Path) -> tuple[dict[str, Any], dict[str, Any]]:
     )
     free = m.boundary.difference(shapely.union_all(m.obstacles))
     s = spec["size"]
+    a, b = s * 2 / 3, s / 2  # the target's half sizes
     g = _centre(free, [], 0.0)
     h = _in_sight(free, g, spec["h_sep"], spec["size"] / 2)
     st = _centre(free, [g, h], spec["h_sep"])
@@ -207,7 +210,7 @@ def build(name: str, pgm: Path) -> tuple[dict[str, Any], dict[str, Any]]:
         "name": name,
         "bounds": _ring(m.boundary),
         "obstacles": [_ring(o) for o in m.obstacles],
-        "target": [[-s * 2 / 3, -s / 2], [s * 2 / 3, -s / 2], [s * 2 / 3, s / 2], [-s * 2 / 3, s / 2]],
+        "target": [[-a, -b], [a, -b], [a, b], [-a, b]],
         "goal": _pentagon(g, s),
         "failure": _pentagon(h, s),
         "start": [st.x, st.y, 0.0],

@@ -47,6 +47,7 @@ import numpy as np
 import shapely
 from scipy import ndimage
 from shapely.geometry import Polygon
+from shapely.geometry.polygon import orient
 
 from .formats import FormatError, scene_from_shapely
 from .scene import Scene
@@ -415,8 +416,8 @@ def read_occupancy_grid(
         return np.column_stack([ox + (c[:, 0] + dx) * res, oy + (c[:, 1] + dy) * res])
 
     poly = shapely.transform(shapely.normalize(poly), world)
-    boundary = Polygon(poly.exterior)
-    obstacles = [Polygon(r) for r in poly.interiors]
+    boundary = orient(Polygon(poly.exterior), 1.0)  # counter-clockwise rings
+    obstacles = [orient(Polygon(r), 1.0) for r in poly.interiors]
     return RosMap(boundary=boundary, obstacles=obstacles, cells=int(room.sum()))
 
 

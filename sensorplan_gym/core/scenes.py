@@ -2,9 +2,10 @@
 
 :func:`load_scene` takes a bundled scene name, a path to a scene file in any of the
 formats of :mod:`geometry.formats` (scene JSON, GeoJSON, WKT; by extension, and for
-``.json`` by content), a parsed dict (scene JSON or a GeoJSON FeatureCollection) or a
-:class:`geometry.Scene`.  The envs' ``scene=``, ``sensorplan view``, ``sensorplan
-convert`` and the tools that take scene names all call it.
+``.json`` by content) or a ROS occupancy-grid map YAML with the scene's extra keys
+(:func:`geometry.occupancy.scene_from_ros_map`), a parsed dict (scene JSON or a GeoJSON
+FeatureCollection) or a :class:`geometry.Scene`.  The envs' ``scene=``, ``sensorplan view``,
+``sensorplan convert`` and the tools that take scene names all call it.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ from pathlib import Path
 
 from geometry import Scene
 from geometry.formats import SCENE_SUFFIXES, load_scene_file, scene_from_data
+from geometry.occupancy import ROS_MAP_SUFFIXES, scene_from_ros_map
 
 __all__ = ["BUNDLED_SCENES", "SCENE_DIR", "SCENE_SUFFIXES", "bundled_scene_path", "load_scene"]
 
@@ -53,13 +55,16 @@ def load_scene(spec: str | PathLike[str] | Scene | Mapping, *, name: str | None 
             scene = Scene.load(bundled_scene_path(s))
         else:
             p = Path(s)
-            if p.suffix.lower() not in SCENE_SUFFIXES and not p.exists():
+            suffixes = SCENE_SUFFIXES + ROS_MAP_SUFFIXES
+            if p.suffix.lower() not in suffixes and not p.exists():
                 raise ValueError(
                     f"unknown scene {s!r}: use a bundled name ({', '.join(BUNDLED_SCENES)}) "
-                    f"or a path to a scene file ({', '.join(SCENE_SUFFIXES)}); the envs also "
+                    f"or a path to a scene file ({', '.join(suffixes)}); the envs also "
                     "take 'random'"
                 )
             if not p.exists():
                 raise FileNotFoundError(f"scene file not found: {p}")
+            if p.suffix.lower() in ROS_MAP_SUFFIXES:
+                return scene_from_ros_map(p, name=name)
             return load_scene_file(p, name=name)
     return scene if name is None else scene.replace(name=name)
