@@ -37,6 +37,7 @@ NAMES = (
     "envs",
     "oracle",
     "policies",
+    "real_maps",
     "regions",
     "scaling",
     "swept",
