@@ -12,7 +12,7 @@ import shapely
 
 import sensorplan_gym
 from geometry import Scene, complete_region, partial_region, recognizable_region
-from geometry.formats import FormatError
+from geometry.formats import FormatError, scene_from_shapely
 from geometry.occupancy import (
     free_mask,
     read_occupancy_grid,
@@ -180,6 +180,24 @@ def test_random_maps_match_a_flood_fill(tmp_path, seed):
     assert m.cells == ref.sum()
     for o in m.obstacles:
         assert o.is_valid and m.boundary.covers(o)
+    # unsimplified and simplified, the pieces make a scene (holes touching the walls or
+    # each other at a pixel corner included)
+    for simplify in (0.0, 0.4, 1.0):
+        mm = read_occupancy_grid(
+            f, resolution=res, origin=(ox, oy), seed=(sx, sy), simplify=simplify
+        )
+        free_space = mm.boundary.difference(shapely.union_all(mm.obstacles))
+        parts = sorted(shapely.get_parts(free_space), key=lambda g: -g.area)
+        c = shapely.get_coordinates(shapely.maximum_inscribed_circle(parts[0], 1e-3))[0]
+        s = scene_from_shapely(
+            bounds=mm.boundary,
+            obstacles=mm.obstacles,
+            target=shapely.box(-0.01, -0.01, 0.01, 0.01),
+            goal=shapely.Point(c),
+            failure=shapely.Point(c + [0.05, 0.0]),
+        )
+        assert len(s.obstacles) == len(mm.obstacles)
+        assert _edges(s) == mm.n_edges and (simplify == 0.0 or mm.n_edges <= m.n_edges)
 
 
 # ------------------------------------------------------------------------------------------
@@ -356,3 +374,46 @@ def test_real_scene_swept_and_recognizable_nonempty():
     assert swept.area > 0
     rec = recognizable_region(Scene.load(REAL / "willow_south.json"), model="partial", theta=0.0)
     assert rec.area > 0
+
+
+def test_make_real_maps_records_what_it_used():
+    from benchmarks import make_real_maps as mk
+
+    prov = json.loads((REAL / "provenance.json").read_text())
+    assert set(mk.SCENES) == set(prov)
+    for name, spec in mk.SCENES.items():
+        p = prov[name]
+        for k in ("crop", "simplify", "min_obstacle_area", "min_width", "h_sep"):
+            assert p[k] == spec[k], (name, k)
+        src = mk.SOURCES[spec["source"]]
+        for k in ("repository", "path", "commit", "licence", "sha256", "resolution", "origin"):
+            assert p[k] == src[k], (name, k)
+
+
+def test_make_real_maps_build_places_g_h_start(tmp_path, monkeypatch):
+    """The generator on a synthetic two-room map (its source checksum patched in): G, H and
+    the start are placed in the free space, H in sight of G, and the regions are not empty;
+    a wrong checksum stops it."""
+    import hashlib
+
+    from benchmarks import make_real_maps as mk
+
+    img = np.full((40, 60), OCC, dtype=np.int64)
+    img[1:39, 1:29] = FREE
+    img[1:39, 31:59] = FREE
+    img[18:24, 29:31] = FREE  # a doorway
+    img[8:12, 8:12] = OCC  # a pillar
+    f = _write_p5(tmp_path / "two.pgm", img)
+    src = dict(mk.WILLOW, sha256=hashlib.sha256(f.read_bytes()).hexdigest(), resolution=0.1)
+    monkeypatch.setitem(mk.SOURCES, "synthetic", src)
+    spec = dict(mk.SCENES["willow_south"], source="synthetic", crop=None, h_sep=1.5)
+    monkeypatch.setitem(mk.SCENES, "synthetic", spec)
+    d, prov = mk.build("synthetic", f)
+    s = Scene.from_dict(d)
+    assert prov["edges"] == _edges(s) and prov["sha256"] == src["sha256"]
+    g, h = s.goal_geom.centroid, s.failure_geom.centroid
+    assert g.distance(h) >= 1.5 - 1e-6
+    assert s.free_space.covers(shapely.LineString([g, h]))
+    assert recognizable_region(s, model="complete", theta=0.0).area > 0
+    with pytest.raises(SystemExit, match="SHA-256"):
+        mk.build("willow_south", f)
