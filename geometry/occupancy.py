@@ -37,6 +37,7 @@ from __future__ import annotations
 
 import json
 import math
+import numbers
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from os import PathLike
@@ -182,6 +183,11 @@ def _yaml_value(text: str, where: str) -> Any:
         try:
             return json.loads(t)
         except json.JSONDecodeError as e:
+            if " #" in t:  # a trailing comment
+                try:
+                    return json.loads(t.rsplit(" #", 1)[0])
+                except json.JSONDecodeError:
+                    pass
             raise FormatError(f"{where}: expected a JSON-style list or object: {e}") from None
     if len(t) >= 2 and t[0] == t[-1] and t[0] in "\"'":
         return t[1:-1]
@@ -256,7 +262,7 @@ class RosMap:
 
 
 def _finite(v: Any, where: str) -> float:
-    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+    if isinstance(v, (bool, np.bool_)) or not isinstance(v, numbers.Real) or not math.isfinite(v):
         raise FormatError(f"{where}: expected a finite number, got {v!r}")
     return float(v)
 
@@ -312,7 +318,8 @@ def read_occupancy_grid(
     Returns:
         A :class:`RosMap`: the boundary polygon (no holes) and the obstacle polygons (the
         boundary's former holes; simple, inside the boundary, possibly touching it or each
-        other at a point), world frame, metres.
+        other at a point), world frame, metres, counter-clockwise; and the room's number of
+        free cells.
     """
     p = Path(pgm_path)
     res = _finite(resolution, f"{p}: resolution")

@@ -261,7 +261,8 @@ def _map_yaml(tmp_path: Path, extra: str = "") -> Path:
     _write_p5(tmp_path / "room.pgm", img)
     y = tmp_path / "room.yaml"
     y.write_text(
-        "image: room.pgm\nresolution: 0.5  # metres\norigin: [-1.0, -1.0, 0.0]\nnegate: 0\n"
+        "image: room.pgm\nresolution: 0.5  # metres\norigin: [-1.0, -1.0, 0.0]  # x, y, yaw\n"
+        "negate: 0\n"
         "occupied_thresh: 0.65\nfree_thresh: 0.196\n" + extra
     )
     return y
@@ -313,6 +314,9 @@ def test_ros_yaml_errors(tmp_path):
         load_scene(y)
     y.write_text("image: nosuch.pgm\nresolution: 0.5\n" + SCENE_KEYS)
     with pytest.raises(FormatError, match=r"nosuch\.pgm: cannot read"):
+        load_scene(y)
+    y.write_text("image: room.pgm\nresolution: 0.5\norigin: [0, 0\n" + SCENE_KEYS)
+    with pytest.raises(FormatError, match=r"line 3 \(origin\): expected a JSON-style list"):
         load_scene(y)
     y.write_text("image: room.pgm\nresolution: 0.5\nmode: raw\n" + SCENE_KEYS)
     with pytest.raises(FormatError, match=r"mode 'raw' is not supported"):
