@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import hashlib
 import json
 from collections import deque
 from pathlib import Path
@@ -11,6 +12,7 @@ import pytest
 import shapely
 
 import sensorplan_gym
+from benchmarks import make_real_maps as mk
 from geometry import Scene, complete_region, partial_region, recognizable_region
 from geometry.formats import FormatError, scene_from_shapely
 from geometry.occupancy import (
@@ -381,8 +383,6 @@ def test_real_scene_swept_and_recognizable_nonempty():
 
 
 def test_make_real_maps_records_what_it_used():
-    from benchmarks import make_real_maps as mk
-
     prov = json.loads((REAL / "provenance.json").read_text())
     assert set(mk.SCENES) == set(prov)
     for name, spec in mk.SCENES.items():
@@ -398,10 +398,6 @@ def test_make_real_maps_build_places_g_h_start(tmp_path, monkeypatch):
     """The generator on a synthetic two-room map (its source checksum patched in): G, H and
     the start are placed in the free space, H in sight of G, and the regions are not empty;
     a wrong checksum stops it."""
-    import hashlib
-
-    from benchmarks import make_real_maps as mk
-
     img = np.full((40, 60), OCC, dtype=np.int64)
     img[1:39, 1:29] = FREE
     img[1:39, 31:59] = FREE
