@@ -417,3 +417,59 @@ def test_make_real_maps_build_places_g_h_start(tmp_path, monkeypatch):
     assert recognizable_region(s, model="complete", theta=0.0).area > 0
     with pytest.raises(SystemExit, match="SHA-256"):
         mk.build("willow_south", f)
+
+
+@pytest.mark.parametrize("name", IN_RANGE)
+def test_real_scene_regions_agree_with_cgal(name):
+    """Membership in the stationary complete and partial regions and the recognizable region
+    (complete model, polygonal G/H) agrees with CGAL's visibility (pyvispoly, tests/oracle.py)
+    at 120 random free placements (those within 1e-4 of the diameter of a region's boundary
+    skipped)."""
+    pytest.importorskip("pyvispoly")
+    from tests import oracle as pv
+
+    s = Scene.load(REAL / f"{name}.json")
+    orc = pv.VisOracle(s)
+    c = s.goal_geom.representative_point()
+    target = s.target_at(c.x, c.y, 0.0)
+    rng = np.random.default_rng(3)
+    fs = s.free_space
+    x0, y0, x1, y1 = fs.bounds
+    cand = rng.uniform([x0, y0], [x1, y1], (2000, 2))
+    pts = cand[shapely.contains_xy(fs, cand[:, 0], cand[:, 1])][:120]
+    vis = [orc.visibility(p) for p in pts]
+    a0 = s.target_at(0.0, 0.0, 0.0)
+    swept = [pv.minkowski_sum(a0, s.goal_geom), pv.minkowski_sum(a0, s.failure_geom)]
+
+    def outside(p, area):
+        return not area.covers(shapely.Point(p))
+
+    checks = {
+        "complete": (
+            complete_region(s, target_at=(c.x, c.y, 0.0)),
+            lambda i, p: outside(p, target) and pv.sees_completely(orc, p, target, vis[i]),
+        ),
+        "partial": (
+            partial_region(s, target_at=(c.x, c.y, 0.0)),
+            lambda i, p: outside(p, target) and pv.sees_partially(orc, p, target, vis[i]),
+        ),
+        "recognizable": (
+            recognizable_region(s, model="complete", theta=0.0),
+            lambda i, p: all(
+                outside(p, a) and pv.sees_completely(orc, p, a, vis[i]) for a in swept
+            ),
+        ),
+    }
+    for what, (region, verdict) in checks.items():
+        bd = region.boundary
+        checked = inside = bad = 0
+        for i, p in enumerate(pts):
+            pt = shapely.Point(p)
+            if bd.distance(pt) < 1e-4 * s.diameter:
+                continue
+            checked += 1
+            got = bool(region.covers(pt))
+            inside += got
+            bad += got != bool(verdict(i, p))
+        assert checked >= 100 and 0 < inside < checked, (what, checked, inside)
+        assert bad == 0, f"{name} {what}: {bad} of {checked} placements disagree with CGAL"
