@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import hashlib
+import importlib.util
 import json
 from collections import deque
 from pathlib import Path
@@ -375,9 +376,33 @@ def test_real_scene_stationary_regions_nonempty(name):
 
 
 def test_real_scene_swept_and_recognizable_nonempty():
+    """The swept partial region and the partial-model recognizable region answer on a real
+    map and are not empty; the swept region lies in the stationary one at every sampled
+    configuration of G, and (one-sided, CGAL) its placements away from its boundary see part
+    of the target at G's vertices and at interior samples of G."""
     s = Scene.load(REAL / "willow_south.json")
     swept = partial_region(s, target_in="goal", theta=0.0)
     assert swept.area > 0
+    g = s.goal_geom
+    rng = np.random.default_rng(1)
+    x0, y0, x1, y1 = g.bounds
+    cand = rng.uniform([x0, y0], [x1, y1], (200, 2))
+    qs = np.vstack([s.goal, cand[shapely.contains_xy(g, cand[:, 0], cand[:, 1])][:10]])
+    for q in qs[:2]:
+        stat = partial_region(s, target_at=(q[0], q[1], 0.0))
+        assert swept.difference(stat).area <= 1e-9 * swept.area
+    if importlib.util.find_spec("pyvispoly") is not None:
+        from tests import oracle as pv
+
+        orc = pv.VisOracle(s)
+        shrunk = swept.buffer(-1e-3 * s.diameter)
+        c = rng.uniform(shrunk.bounds[:2], shrunk.bounds[2:], (4000, 2))
+        pts = c[shapely.contains_xy(shrunk, c[:, 0], c[:, 1])][:30]
+        assert len(pts) == 30
+        for p in pts:
+            vis = orc.visibility(p)
+            for q in qs:
+                assert pv.sees_partially(orc, p, s.target_at(q[0], q[1], 0.0), vis), (p, q)
     rec = recognizable_region(Scene.load(REAL / "willow_south.json"), model="partial", theta=0.0)
     assert rec.area > 0
 
