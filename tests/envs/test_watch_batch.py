@@ -1,0 +1,207 @@
+"""The watch task on the batched core (issue 23): copy ``e`` of a batch equals
+``watch_v0.parallel_env`` seeded ``s + e`` (whole episodes, noise and narrow views on); the
+numpy fallback answers bitwise as the compiled kernels; the compiled "sees A" filter agrees
+with the exact shapely predicate wherever it answers; the casts from inside A; the vector
+env's API."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import shapely
+
+from sensorplan_gym import watch_v0
+from sensorplan_gym.core.kernels import HAVE_NUMBA
+from sensorplan_gym.core.sensor import Segments, cast_batch
+from sensorplan_gym.multiagent import WatchBatch
+from sensorplan_gym.multiagent import kernels as wk
+
+CONFIGS = [
+    dict(scene="edr", n_watchers=2, noise=0.05, fov_deg=120, max_range=6.0),
+    dict(scene="lab", n_watchers=3, reward="team", noise=0.02),
+    dict(scene="corridor", n_watchers=1, robot_radius=0.15, fov_deg=200),
+    dict(scene="warehouse", n_watchers=2, model="partial", max_steps=30, move_steps=15),
+]
+
+
+def _acts(rng, n):
+    a = rng.uniform(-1, 1, (n, 4)).astype(np.float32)
+    a[:, 3] = np.where(rng.random(n) < 0.02, np.sign(a[:, 3]), 0.0)  # declare rarely
+    return a
+
+
+@pytest.mark.parametrize("cfg", CONFIGS, ids=lambda c: f"{c['scene']}-{c['n_watchers']}")
+def test_copy_of_batch_equals_parallel_env(cfg):
+    """Copy e of the vector env seeded s equals the parallel env seeded s + e, step for step
+    over two whole episodes each (the second after the vector env's autoreset)."""
+    E, A = 3, cfg["n_watchers"]
+    venv = watch_v0.vector_env(E, **cfg)
+    singles = [watch_v0.parallel_env(**cfg) for _ in range(E)]
+    obs, info = venv.reset(seed=21)
+    for e, env in enumerate(singles):
+        o, inf = env.reset(seed=21 + e)
+        for a, name in enumerate(env.possible_agents):
+            assert np.array_equal(o[name], obs[e * A + a])
+            assert inf[name]["sees"] == info["sees"][e * A + a]
+    H = singles[0].max_steps
+    rng = np.random.default_rng(0)
+    finals = 0
+    for step in range(2 * H + 1):
+        act = _acts(rng, E * A)
+        obs, rew, term, trunc, info = venv.step(act)
+        assert not trunc.any()
+        for e, env in enumerate(singles):
+            rows = slice(e * A, (e + 1) * A)
+            if not env.agents:  # the vector env reset this copy (NEXT_STEP)
+                o, _ = env.reset()
+                assert not term[rows].any() and (rew[rows] == 0).all()
+                for a, name in enumerate(env.possible_agents):
+                    assert np.array_equal(o[name], obs[e * A + a])
+                continue
+            o, r, te, tr, inf = env.step({n: act[e * A + a] for a, n in enumerate(env.agents)})
+            for a, name in enumerate(env.possible_agents):
+                i = e * A + a
+                assert np.array_equal(o[name], obs[i]), (step, e, a)
+                assert r[name] == rew[i]
+                assert te[name] == term[i]
+                assert inf[name]["sees"] == info["sees"][i]
+                assert inf[name]["collided"] == info["collided"][i]
+                assert inf[name]["pose"] == venv.batch.pose(i)
+                if te[name]:
+                    finals += 1
+                    assert info["_is_success"][i]
+                    assert inf[name]["is_success"] == info["is_success"][i]
+                    assert inf[name]["visible_fraction"] == info["visible_fraction"][i]
+    assert finals == 2 * E * A
+
+
+def _run_batch(cfg, fused: bool, steps: int):
+    b = WatchBatch(2, **cfg)
+    b.fused = fused
+    idx = np.arange(2)
+    for e in range(2):
+        b.seed_env(e, 5 + e)
+    b.reset_envs(idx)
+    rng = np.random.default_rng(3)
+    trace = [(b.observe(idx), b.P.copy(), b.sees.copy())]
+    for _ in range(steps):
+        act = b.check_actions(_acts(rng, b.n), b.n)
+        rew, done, _ = b.step_envs(act, idx)
+        trace.append((b.observe(idx), b.P.copy(), b.sees.copy(), rew, b.scan_dist.copy(),
+                      b.scan_normal.copy(), b.map_dist.copy(), b.collided.copy()))  # fmt: skip
+        if done.any():
+            b.reset_envs(idx[done])
+    return trace, b
+
+
+@pytest.mark.skipif(not HAVE_NUMBA, reason="numba not installed: only the numpy path exists")
+@pytest.mark.parametrize("cfg", CONFIGS[:3], ids=lambda c: c["scene"])
+def test_numpy_fallback_is_bitwise_equal(cfg):
+    steps = 130
+    fast, bf = _run_batch(cfg, True, steps)
+    slow, bs = _run_batch(cfg, False, steps)
+    assert len(fast) == len(slow)
+    for k, (x, y) in enumerate(zip(fast, slow, strict=True)):
+        for u, v in zip(x, y, strict=True):
+            assert u.dtype == v.dtype and np.array_equal(u, v), k
+    # the filter answered most "sees A" questions itself (numpy asks shapely every time)
+    assert bf.n_exact_sees < 0.2 * bs.n_exact_sees
+
+
+@pytest.mark.skipif(not HAVE_NUMBA, reason="the compiled filter needs numba")
+@pytest.mark.parametrize("scene", ["lab", "edr", "corridor", "warehouse"])
+def test_sees_filter_agrees_with_exact_predicate(scene):
+    """Wherever the compiled filter answers, it answers as WatchWorld.sees (shapely, exact);
+    it leaves only a few cases to the predicate."""
+    rng = np.random.default_rng(4)
+    counts = {wk.SEES_NO: 0, wk.SEES_YES: 0, wk.UNSURE: 0}
+    for fov, mr in ((None, None), (100.0, None), (360.0, 5.0), (220.0, 8.0)):
+        b = WatchBatch(1, scene, fov_deg=fov, max_range=mr)
+        w = b.world
+        b.reset_envs(np.zeros(1, dtype=np.int64))
+        for _ in range(6):
+            t = int(rng.integers(0, b.move_steps + 1))
+            q = b.trajs[0].at(t)
+            b.Q[0] = q
+            b._set_a(np.zeros(1, dtype=np.int64))
+            for _ in range(40):
+                x, y, _ = b.draw_pose(rng, [], None)
+                c = (w.target + q).mean(axis=0)
+                psi = (
+                    math.atan2(c[1] - y, c[0] - x) + rng.normal(0, 0.4)
+                    if rng.random() < 0.6
+                    else rng.uniform(-math.pi, math.pi)
+                )
+                inside = bool(shapely.contains_xy(shapely.Polygon(w.target + q), x, y))
+                code = wk.sees_filter(x, y, psi, inside, q[0], q[1], b._tgt, b._hull, b.SS,
+                                      b.prm, b._HP)  # fmt: skip
+                counts[code] += 1
+                if code != wk.UNSURE:
+                    assert (code == wk.SEES_YES) == w.sees((x, y, psi), q), (scene, fov, mr)
+    assert counts[wk.SEES_YES] >= 30 and counts[wk.SEES_NO] >= 30, counts
+    assert counts[wk.UNSURE] <= 0.02 * sum(counts.values()), counts
+
+
+@pytest.mark.parametrize("fused", [True, False])
+def test_cast_from_inside_a_matches_unculled_cast(fused):
+    """A watcher that A has moved over reads A's edges from inside (as an unculled cast
+    against the map's and A's edges does), and the map's prediction ignores A."""
+    if fused and not HAVE_NUMBA:
+        pytest.skip("numba not installed")
+    b = WatchBatch(1, "lab", n_watchers=2)
+    b.fused = fused
+    idx = np.zeros(1, dtype=np.int64)
+    b.seed_env(0, 1)
+    b.reset_envs(idx)
+    q = b.Q[0]
+    P = b.world.target_at(q)
+    c = P.mean(axis=0)
+    b.P[:, 0] = (c[0], c[1], 0.3)  # inside A
+    b._move_sense(idx, None)
+    assert b.inside[0] and not b.inside[1] and not b.sees[0]
+    segs = np.concatenate([P, np.roll(P, -1, axis=0)], axis=1)
+    allsegs = b.world.seg_set + Segments(segs)
+    for i in range(2):
+        x, y, psi = b.P[:, i]
+        ang = (b.sensor.offsets + psi)[None, :]
+        d, nrm, hit = cast_batch(np.array([x]), np.array([y]), ang, allsegs, b.world.reach)
+        np.testing.assert_allclose(b.scan_dist[i], d[0], rtol=1e-12, atol=1e-12)
+        np.testing.assert_allclose(b.scan_normal[i], nrm[0], atol=1e-12)
+        assert np.array_equal(b.scan_hit[i], hit[0])
+        dm, _, _ = cast_batch(np.array([x]), np.array([y]), ang, b.world.seg_set, b.world.reach)
+        np.testing.assert_allclose(b.map_dist[i], dm[0], rtol=1e-12, atol=1e-12)
+    assert (b.scan_dist[0] < 0.1 * b.world.diameter).all()  # A's own edges, from inside
+
+
+def test_vector_env_api():
+    from gymnasium.vector import AutoresetMode
+
+    venv = watch_v0.vector_env(4, scene="edr", n_watchers=2, max_steps=6, move_steps=3)
+    assert venv.num_envs == 8 and venv.metadata["autoreset_mode"] == AutoresetMode.NEXT_STEP
+    assert venv.observation_space.shape == (8, 8 + 4 * 16 + 3 + 2)
+    obs, info = venv.reset(seed=[1, 2, 3, 4])
+    assert obs.shape == venv.observation_space.shape and obs.dtype == np.float32
+    assert venv.observation_space.contains(obs)
+    single = watch_v0.parallel_env(scene="edr", n_watchers=2, max_steps=6, move_steps=3)
+    o, _ = single.reset(seed=3)
+    assert np.array_equal(o["watcher_1"], obs[5])
+    for k in range(6):
+        obs, rew, term, trunc, info = venv.step(np.zeros((8, 4), dtype=np.float32))
+        assert term.all() == (k == 5)
+    assert (rew == rew[0] + 0 * rew).shape == (8,) and "_is_success" in info
+    assert info["_is_success"].all() and not info["is_success"].any()  # nobody declared
+    obs, rew, term, trunc, info = venv.step(np.zeros((8, 4)))  # the autoreset step
+    assert not term.any() and (rew == 0).all() and (obs[:, 8 + 4 * 16] == 0).all()
+    before = venv.batch.t.copy()
+    venv.reset(options={"reset_mask": np.array([True, False, False, False])})
+    assert venv.batch.t[0] == 0 and (venv.batch.t[1:] == before[1:]).all()
+    with pytest.raises(ValueError, match="NaN"):
+        venv.step(np.full((8, 4), np.nan))
+    with pytest.raises(ValueError, match="shape"):
+        venv.step(np.zeros((7, 4)))
+    with pytest.raises(ValueError, match="reset_mask"):
+        venv.reset(options={"reset_mask": np.ones(8, dtype=bool)})
+    with pytest.raises(ValueError, match="n_envs"):
+        watch_v0.vector_env(0)
