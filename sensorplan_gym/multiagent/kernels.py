@@ -63,7 +63,7 @@ WRAP_TOL = 1e-6
 
 
 if HAVE_NUMBA:  # pragma: no cover - exercised when numba is installed
-    from ..core.fused import _cast_row, _obs_row, _sweep_point, _wrap, point_in_region
+    from ..core.fused import _cast_row, _obs_row, _sweep_point, _wrap, orient_sign, point_in_region
 
     njit = numba.njit(cache=True, nogil=True, error_model="numpy")
 
@@ -374,5 +374,81 @@ if HAVE_NUMBA:  # pragma: no cover - exercised when numba is installed
                     out[r, m + 1] = np.float32((c * gy - s * gx) * inv)
                     m += 2
 
+    @njit
+    def _cone_side(ux, uy, vx, vy, wx, wy, ax, ay):
+        """Whether ``a`` lies strictly inside the domain's angle at vertex ``v`` between its
+        incoming edge ``u -> v`` and outgoing edge ``v -> w`` (interior on the left): 1 yes,
+        0 no, -1 on a bounding ray or a degenerate vertex."""
+        o_in = orient_sign(ux, uy, vx, vy, ax, ay)
+        o_out = orient_sign(vx, vy, wx, wy, ax, ay)
+        if o_in == 0 or o_out == 0:
+            return -1
+        turn = orient_sign(ux, uy, vx, vy, wx, wy)
+        if turn == 0:
+            if (vx - ux) * (wx - vx) + (vy - uy) * (wy - vy) <= 0.0:
+                return -1  # a spike
+            turn = 1
+        if turn > 0:
+            return 1 if (o_in > 0 and o_out > 0) else 0
+        return 1 if (o_in > 0 or o_out > 0) else 0
+
+    @njit
+    def visible_from(ax, ay, nodes, E, pin, pout, amb, out):
+        """For every boundary vertex ``nodes[k]`` of a polygonal domain, whether the segment
+        from ``(ax, ay)`` to it lies in the (closed) domain -- ``shapely.covers(domain,
+        segment)`` -- decided with exact orientations: 1 yes, 0 no, :data:`UNSURE` when the
+        segment meets a boundary vertex or runs along an edge, ``a`` lies on the boundary, or
+        the vertex is not simple (``amb``).  ``E (4, M)``: the boundary's edges (start x, y,
+        end x, y), interior on their left; ``pin``/``pout``: each vertex's incoming and
+        outgoing edge."""
+        M = E.shape[1]
+        for k in range(nodes.shape[0]):
+            vx = nodes[k, 0]
+            vy = nodes[k, 1]
+            if amb[k] or (vx == ax and vy == ay):
+                out[k] = UNSURE
+                continue
+            ei = pin[k]
+            eo = pout[k]
+            side = _cone_side(E[0, ei], E[1, ei], vx, vy, E[2, eo], E[3, eo], ax, ay)
+            if side < 0:
+                out[k] = UNSURE
+                continue
+            if side == 0:
+                out[k] = 0
+                continue
+            x0 = min(ax, vx)
+            x1 = max(ax, vx)
+            y0 = min(ay, vy)
+            y1 = max(ay, vy)
+            res = 1
+            for j in range(M):
+                if j == ei or j == eo:
+                    continue
+                px = E[0, j]
+                py = E[1, j]
+                qx = E[2, j]
+                qy = E[3, j]
+                if max(px, qx) < x0 or min(px, qx) > x1 or max(py, qy) < y0 or min(py, qy) > y1:
+                    continue
+                o1 = orient_sign(ax, ay, vx, vy, px, py)
+                o2 = orient_sign(ax, ay, vx, vy, qx, qy)
+                if o1 == 0 and x0 <= px <= x1 and y0 <= py <= y1:
+                    res = UNSURE
+                    break
+                if o2 == 0 and x0 <= qx <= x1 and y0 <= qy <= y1:
+                    res = UNSURE
+                    break
+                if o1 * o2 < 0:
+                    o3 = orient_sign(px, py, qx, qy, ax, ay)
+                    o4 = orient_sign(px, py, qx, qy, vx, vy)
+                    if o3 == 0 or o4 == 0:
+                        res = UNSURE
+                        break
+                    if o3 * o4 < 0:
+                        res = 0
+                        break
+            out[k] = res
+
 else:  # pragma: no cover - without numba
-    set_a = sees_filter = watch_step = obs_kernel = None
+    set_a = sees_filter = watch_step = obs_kernel = visible_from = None

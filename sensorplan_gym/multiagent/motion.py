@@ -141,9 +141,10 @@ def _execute(world: WatchWorld, cfg: MotionConfig, path: np.ndarray, rng) -> np.
     out[0] = nominal[0]
     emax = cfg.drift * world.diameter
     sigma = 0.25 * emax
+    clear = world.clearances(nominal[1:, 0], nominal[1:, 1])  # one vectorised query
     for t in range(1, T + 1):
         q = nominal[t]
-        r = min(emax, max(0.0, world.clearance(q[0], q[1]) - world.skin))
+        r = min(emax, max(0.0, float(clear[t - 1]) - world.skin))
         r *= min(1.0, (T - t) / cfg.settle_steps)
         e = e + rng.normal(0.0, sigma, 2) if r > 0 else np.zeros(2)
         n = math.hypot(e[0], e[1])
