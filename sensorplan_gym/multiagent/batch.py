@@ -291,15 +291,20 @@ class WatchBatch:
                 self._fixed_starts = poses
             return list(self._fixed_starts)
         poses: list[tuple[float, float, float]] = []
+        a_poly = shapely.Polygon(a_poly)
+        shapely.prepare(a_poly)
         while len(poses) < self.n_watchers:
             poses.append(self.draw_pose(rng, poses, a_poly))
         return poses
 
     def draw_pose(self, rng, others, a_poly=None) -> tuple[float, float, float]:
         """A uniform free pose (rejection from the bounding box) away from the poses
-        ``others`` and -- unless ``a_poly`` is None -- from A's outline ``a_poly (K, 2)``."""
+        ``others`` and -- unless ``a_poly`` is None -- from A's outline ``a_poly`` (``(K, 2)``
+        vertices or a polygon)."""
         w = self.world
-        A = None if a_poly is None else shapely.Polygon(a_poly)
+        A = a_poly if a_poly is None or isinstance(a_poly, shapely.Geometry) else None
+        if A is None and a_poly is not None:
+            A = shapely.Polygon(a_poly)
         gap = self.robot_radius + 0.02 * w.diameter
         for _ in range(10_000):
             x = rng.uniform(w.lo[0], w.hi[0])
@@ -506,17 +511,18 @@ class WatchBatch:
     def observe(self, idx: np.ndarray) -> np.ndarray:
         """Observations ``(len(idx) * A, D)`` float32 of the watchers of copies ``idx``."""
         idx = np.asarray(idx, dtype=np.int64)
+        out = np.empty((len(idx) * self.n_watchers, self.obs_dim), dtype=np.float32)
+        if self.fused:
+            wk.obs_kernel(idx, self.n_watchers, self.P, self._obs_consts, self.scan_dist,
+                          self.scan_normal, self.map_dist, self.t, self.declared,
+                          self.max_steps, self.move_steps, self._low, out)  # fmt: skip
+            return out
         A = self.n_watchers
         tail = np.empty((self.n_envs, 2 + A))
         tail[idx, 0] = self.t[idx] / self.max_steps
         tail[idx, 1] = (self.t[idx] >= self.move_steps).astype(np.float64)
         tail[idx, 2:] = self.declared[idx]
-        out = np.empty((len(idx) * A, self.obs_dim), dtype=np.float32)
-        if self.fused:
-            wk.obs_kernel(idx, A, self.P, self._obs_consts, self.scan_dist, self.scan_normal,
-                          self.map_dist, tail, out)  # fmt: skip
-        else:
-            self._observe_numpy(idx, tail, out)
+        self._observe_numpy(idx, tail, out)
         return np.clip(out, self._low, 1.0, out=out)
 
     def _observe_numpy(self, idx, tail, out) -> None:

@@ -342,12 +342,14 @@ if HAVE_NUMBA:  # pragma: no cover - exercised when numba is installed
                 code[i] = sees_filter(x, y, psi, inside, Q[e, 0], Q[e, 1], tgt, hull, SS, prm, HP)
 
     @njit
-    def obs_kernel(idx, nw, P, K, sd, sn, md, tail, out):
+    def obs_kernel(idx, nw, P, K, sd, sn, md, t, dec, max_steps, move_steps, low, out):
         """Observations of the watchers of copies ``idx`` into ``out[:len(idx) * nw]``
-        (float32): :func:`_obs_row`'s ``8 + 4 B`` entries, then ``tail[e]`` (elapsed
-        fraction, plan over; ``tail[e, 2 + w]`` watcher ``w``'s declaration) and the other
-        watchers' positions in the watcher's frame / diameter."""
+        (float32): :func:`_obs_row`'s ``8 + 4 B`` entries, the elapsed fraction ``t[e] /
+        max_steps``, whether A's plan is over, the watcher's declaration ``dec[e, w]`` and the
+        other watchers' positions in its frame / diameter; every entry clipped to
+        ``[low, 1]``."""
         B = sd.shape[1]
+        D = out.shape[1]
         base = 8 + 4 * B
         for k in range(idx.shape[0]):
             e = idx[k]
@@ -355,9 +357,9 @@ if HAVE_NUMBA:  # pragma: no cover - exercised when numba is installed
                 i = e * nw + w
                 r = k * nw + w
                 _obs_row(i, P, K, sd, sn, md, True, out, r)
-                out[r, base] = np.float32(tail[e, 0])
-                out[r, base + 1] = np.float32(tail[e, 1])
-                out[r, base + 2] = np.float32(tail[e, 2 + w])
+                out[r, base] = np.float32(t[e] / max_steps)
+                out[r, base + 1] = np.float32(1.0 if t[e] >= move_steps else 0.0)
+                out[r, base + 2] = np.float32(dec[e, w])
                 x = P[0, i]
                 y = P[1, i]
                 c = math.cos(P[2, i])
@@ -373,6 +375,8 @@ if HAVE_NUMBA:  # pragma: no cover - exercised when numba is installed
                     out[r, m] = np.float32((c * gx + s * gy) * inv)
                     out[r, m + 1] = np.float32((c * gy - s * gx) * inv)
                     m += 2
+                for m in range(D):
+                    out[r, m] = min(max(out[r, m], low[m]), np.float32(1.0))
 
     @njit
     def _cone_side(ux, uy, vx, vy, wx, wy, ax, ay):
