@@ -339,35 +339,38 @@ class WatchBatch:
         done (k,), decl_r (k, A))`` -- ``done``: the horizon is reached (every watcher is
         terminated)."""
         idx = np.asarray(idx, dtype=np.int64)
-        t = self.t[idx] + 1
-        self.t[idx] = t
-        T = self.motion_cfg.move_steps
-        self.Q[idx] = self.TRJ[idx, np.minimum(t, T)]
+        sel = slice(None) if len(idx) == self.n_envs else idx  # views when every copy steps
+        t = self.t[sel]
+        t += 1
+        self.t[sel] = t
+        self.Q[sel] = self.TRJ[idx, np.minimum(t, self.motion_cfg.move_steps)]
         self._set_a(idx)
         self._move_sense(idx, act)
         A = self.n_watchers
         k = len(idx)
         d = act[:, 3].reshape(k, A)
-        want = np.where(d < -1 / 3, -1, np.where(d > 1 / 3, 1, 0))
-        dec = self.declared[idx]
-        new = (dec == 0) & (want != 0)
+        lo, hi = d < -1 / 3, d > 1 / 3
         done = t >= self.max_steps
         decl_r = np.zeros((k, A))
-        if new.any():
-            dec = np.where(new, want, dec)
-            self.declared[idx] = dec
-            truth = self._outcomes(idx)[:, None]
-            decl_r = np.where(new, np.where(want == truth, 1.0, -1.0), 0.0)
+        dec = self.declared[sel]
+        if lo.any() or hi.any():
+            want = np.where(lo, -1, np.where(hi, 1, 0))
+            new = (dec == 0) & (want != 0)
+            if new.any():
+                dec = np.where(new, want, dec)
+                self.declared[sel] = dec
+                truth = self._outcomes(idx)[:, None]
+                decl_r = np.where(new, np.where(want == truth, 1.0, -1.0), 0.0)
         if done.any():
             decl_r = np.where(done[:, None] & (dec == 0), -1.0, decl_r)
         sees = self.sees[self._rows(idx)].reshape(k, A)
-        self.seen_steps[idx] += sees
+        self.seen_steps[sel] += sees
         anyone = sees.any(axis=1)
-        self.team_seen_steps[idx] += anyone
+        self.team_seen_steps[sel] += anyone
         if self.reward_mode == "individual":
-            rew = self.see_reward * sees.astype(np.float64) + decl_r
+            rew = self.see_reward * sees + decl_r
         else:
-            r = self.see_reward * anyone.astype(np.float64) + np.mean(decl_r, axis=1)
+            r = self.see_reward * anyone + np.mean(decl_r, axis=1)
             rew = np.repeat(r[:, None], A, axis=1)
         return rew, done, decl_r
 

@@ -129,7 +129,8 @@ if HAVE_NUMBA:  # pragma: no cover - exercised when numba is installed
         point at ``(qx, qy)``: :data:`SEES_YES`, :data:`SEES_NO`, or :data:`UNSURE` (see the
         module docstring).  ``inside``: the watcher lies inside A; ``tgt (K, 2)`` A's
         vertices and ``hull (H, 2)`` its convex hull's (counter-clockwise) at the origin;
-        ``SS (6, 1, M)`` the map's edges; ``HP (5, H + 2)`` scratch."""
+        ``SS (6, 1, M)`` the map's edges; ``HP (5, H + 2)`` scratch (the fan's sides: a point,
+        the direction and 1 / its length)."""
         eps = prm[W_EPS]
         K = tgt.shape[0]
         d2 = np.inf
@@ -206,7 +207,7 @@ if HAVE_NUMBA:  # pragma: no cover - exercised when numba is installed
                 HP[1, n] = ay
                 HP[2, n] = dx
                 HP[3, n] = dy
-                HP[4, n] = L
+                HP[4, n] = 1.0 / L
                 n += 1
             else:
                 # edge j is seen from p; is the previous / next one not?
@@ -232,7 +233,7 @@ if HAVE_NUMBA:  # pragma: no cover - exercised when numba is installed
             HP[1, n] = ay
             HP[2, n] = dx
             HP[3, n] = dy
-            HP[4, n] = math.hypot(dx, dy)
+            HP[4, n] = 1.0 / math.hypot(dx, dy)
             n += 1
             bx = hull[last, 0] + qx
             by = hull[last, 1] + qy
@@ -240,7 +241,7 @@ if HAVE_NUMBA:  # pragma: no cover - exercised when numba is installed
             HP[1, n] = y
             HP[2, n] = bx - x
             HP[3, n] = by - y
-            HP[4, n] = math.hypot(bx - x, by - y)
+            HP[4, n] = 1.0 / math.hypot(bx - x, by - y)
             n += 1
         elif first >= 0 or last >= 0:
             return UNSURE  # cannot happen for a convex hull; be safe
@@ -260,9 +261,13 @@ if HAVE_NUMBA:  # pragma: no cover - exercised when numba is installed
             # the parts of the edge deeper than eps inside F, and not farther than eps outside
             lo_in, hi_in, lo_near, hi_near = 0.0, 1.0, 0.0, 1.0
             for h in range(n):
-                inv = 1.0 / HP[4, h]
+                inv = HP[4, h]
                 a0 = (HP[2, h] * (y0 - HP[1, h]) - HP[3, h] * (x0 - HP[0, h])) * inv
                 b0 = (HP[2, h] * ey - HP[3, h] * ex) * inv
+                if a0 < -eps and a0 + b0 < -eps:
+                    hi_near = -1.0  # the whole edge farther than eps outside this side
+                    hi_in = -1.0
+                    break
                 # a0 + b0 t > eps (inside) / >= -eps (near)
                 if b0 == 0.0:
                     if not (a0 > eps):
