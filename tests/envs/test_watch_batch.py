@@ -6,7 +6,12 @@ env's API."""
 
 from __future__ import annotations
 
+import hashlib
+import json
 import math
+import os
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -108,6 +113,41 @@ def test_numpy_fallback_is_bitwise_equal(cfg):
             assert u.dtype == v.dtype and np.array_equal(u, v), k
     # the filter answered most "sees A" questions itself (numpy asks shapely every time)
     assert bf.n_exact_sees < 0.2 * bs.n_exact_sees
+
+
+def _digest(cfg: dict, steps: int) -> str:
+    """A hash of every observation, reward, pose and "sees" of a vector env run."""
+    venv = watch_v0.vector_env(2, **cfg)
+    h = hashlib.sha256()
+    obs, _ = venv.reset(seed=8)
+    h.update(obs.tobytes())
+    rng = np.random.default_rng(1)
+    for _ in range(steps):
+        obs, rew, term, _, info = venv.step(_acts(rng, venv.num_envs))
+        for a in (obs, rew, term, info["sees"], venv.batch.P):
+            h.update(np.ascontiguousarray(a).tobytes())
+    return h.hexdigest()
+
+
+@pytest.mark.skipif(not HAVE_NUMBA, reason="numba not installed: only the numpy path exists")
+def test_without_numba_the_same_episodes():
+    """The whole package without numba (SENSORPLAN_NO_NUMBA=1: numpy kernels, shapely for
+    every visibility question) reproduces the compiled episodes bit for bit."""
+    cases, steps = CONFIGS[:2], 110
+    code = (
+        "import json, sys; from tests.envs.test_watch_batch import _digest; "
+        "print(json.dumps([_digest(c, int(sys.argv[2])) for c in json.loads(sys.argv[1])]))"
+    )
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    out = subprocess.run(
+        [sys.executable, "-c", code, json.dumps(cases), str(steps)],
+        env=dict(os.environ, SENSORPLAN_NO_NUMBA="1"),
+        cwd=root,
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    assert json.loads(out.stdout.strip().splitlines()[-1]) == [_digest(c, steps) for c in cases]
 
 
 @pytest.mark.skipif(not HAVE_NUMBA, reason="the compiled filter needs numba")
