@@ -5,7 +5,8 @@
 Every env is stepped with uniform random actions (drawn before timing; the decide component
 0, so that episodes run their full length) and restarts episodes as they end (single envs:
 ``reset()``; vector envs: their own NEXT_STEP autoresets, so A's motion planning at every
-episode start is included).  Each row is timed in chunks of about ``--seconds``, ``--repeats``
+episode start is included).  Each row is timed in chunks of about ``--seconds`` (for the
+watch rows, a whole number of episodes: their copies restart together), ``--repeats``
 times, interleaved with the other rows (a shared, noisy machine slows them alike), and the
 median rate is kept.  Reported: agent steps/s (env steps x watchers), and the ratios to
 Navigate-v0's native vector env and to CartPole-v1's ``CartPoleVectorEnv`` with the same
@@ -36,7 +37,7 @@ CARTPOLE = "CartPole-v1, CartPoleVectorEnv"
 N_ACTS = 512
 
 
-def _gym_runner(env_id: str, **kw) -> tuple[Callable[[int], float], int]:
+def _gym_runner(env_id: str, period: int | None = None, **kw):
     import gymnasium as gym
 
     import sensorplan_gym  # noqa: F401
@@ -58,10 +59,10 @@ def _gym_runner(env_id: str, **kw) -> tuple[Callable[[int], float], int]:
                 env.reset()
         return time.perf_counter() - t0
 
-    return run, 1
+    return run, 1, period
 
 
-def _vec_runner(make: Callable[[], Any], n_rows: int, declare_col: bool):
+def _vec_runner(make: Callable[[], Any], n_rows: int, declare_col: bool, period=None):
     venv = make()
     venv.reset(seed=0)
     rng = np.random.default_rng(0)
@@ -83,7 +84,7 @@ def _vec_runner(make: Callable[[], Any], n_rows: int, declare_col: bool):
             pos[0] += 1
         return time.perf_counter() - t0
 
-    return run, n_rows
+    return run, n_rows, period
 
 
 def _watch_parallel_runner(scene: str, n: int):
@@ -107,10 +108,10 @@ def _watch_parallel_runner(scene: str, n: int):
                 env.reset()
         return time.perf_counter() - t0
 
-    return run, n
+    return run, n, env.max_steps
 
 
-def _runners(scene: str, batch: int) -> dict[str, tuple[Callable[[int], float], int]]:
+def _runners(scene: str, batch: int) -> dict[str, tuple[Callable[[int], float], int, Any]]:
     import gymnasium as gym
 
     import sensorplan_gym  # noqa: F401
@@ -121,7 +122,7 @@ def _runners(scene: str, batch: int) -> dict[str, tuple[Callable[[int], float], 
             env_id, num_envs=batch, vectorization_mode="vector_entry_point", **kw
         )
 
-    r: dict[str, tuple[Callable[[int], float], int]] = {
+    r: dict[str, tuple[Callable[[int], float], int, Any]] = {
         ANCHOR: _vec_runner(vec("sensorplan/Navigate-v0", scene=scene), batch, False),
         CARTPOLE: _vec_runner(vec("CartPole-v1"), batch, False),
     }
@@ -129,7 +130,10 @@ def _runners(scene: str, batch: int) -> dict[str, tuple[Callable[[int], float], 
         for a in (1, 2, 4):
             e = batch // a
             r[f"watch_v0, vector, {e} x {a} watchers"] = _vec_runner(
-                lambda e=e, a=a: watch_v0.vector_env(e, scene=scene, n_watchers=a), e * a, True
+                lambda e=e, a=a: watch_v0.vector_env(e, scene=scene, n_watchers=a),
+                e * a,
+                True,
+                period=101,  # 100 steps, then the autoreset step: all copies in step
             )
         e = batch // 4
         r[f"watch_v0, vector, {e} x 4 watchers, no resets"] = _vec_runner(
@@ -138,7 +142,7 @@ def _runners(scene: str, batch: int) -> dict[str, tuple[Callable[[int], float], 
             True,
         )
     r["Navigate-v0, single env"] = _gym_runner("sensorplan/Navigate-v0", scene=scene)
-    r["Watch-v0 (gym, 1 watcher)"] = _gym_runner("sensorplan/Watch-v0", scene=scene)
+    r["Watch-v0 (gym, 1 watcher)"] = _gym_runner("sensorplan/Watch-v0", 100, scene=scene)
     for a in (1, 2, 4):
         r[f"watch_v0, parallel_env, {a} watcher{'s' if a > 1 else ''}"] = _watch_parallel_runner(
             scene, a
@@ -146,12 +150,16 @@ def _runners(scene: str, batch: int) -> dict[str, tuple[Callable[[int], float], 
     return r
 
 
-def _calls_for(run: Callable[[int], float], seconds: float) -> int:
+def _calls_for(run: Callable[[int], float], seconds: float, period: int | None) -> int:
+    """Calls of ``run`` that take about ``seconds``; a whole number of ``period`` (the
+    episode length, when every episode restarts at the same call: each chunk then holds the
+    same share of resets)."""
     k = 1
     while True:
         dt = run(k)
         if dt >= seconds / 4:
-            return max(1, round(k * seconds / dt))
+            calls = max(1, round(k * seconds / dt))
+            return calls if period is None else period * max(1, round(calls / period))
         k *= 4
 
 
@@ -164,10 +172,10 @@ def main(argv: list[str] | None = None) -> int:
     _results.add_output_args(ap, "watch_throughput")
     a = ap.parse_args(argv)
     runners = _runners(a.scene, a.batch)
-    calls = {k: _calls_for(run, a.seconds) for k, (run, _n) in runners.items()}
+    calls = {k: _calls_for(run, a.seconds, per) for k, (run, _n, per) in runners.items()}
     rates: dict[str, list[float]] = {k: [] for k in runners}
     for _ in range(a.repeats):  # interleaved, so that load changes hit every env alike
-        for k, (run, n) in runners.items():
+        for k, (run, n, _per) in runners.items():
             rates[k].append(calls[k] * n / run(calls[k]))
     data: dict[str, Any] = {
         "command": _results.command("benchmarks.watch_throughput", argv),
@@ -178,7 +186,7 @@ def main(argv: list[str] | None = None) -> int:
         "repeats": a.repeats,
         "rows": [
             {"env": k, "rows": n, "agent_steps_per_s": statistics.median(rates[k])}
-            for k, (_run, n) in runners.items()
+            for k, (_run, n, _per) in runners.items()
         ],
     }
     print(render(data))

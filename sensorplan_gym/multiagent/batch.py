@@ -214,11 +214,9 @@ class WatchBatch:
         L = np.hypot(tn[:, 0], tn[:, 1])
         L[L == 0] = 1.0
         tn = tn / L[:, None]
-        area2 = float(np.sum(tgt[:, 0] * np.roll(tgt[:, 1], -1) - np.roll(tgt[:, 0], -1) * tgt[:, 1]))
-        self._tnrm = np.ascontiguousarray(-tn if area2 > 0 else tn)  # out of A
+        self._tnrm = np.ascontiguousarray(-tn if _area2(tgt) > 0 else tn)  # out of A
         hull = np.asarray(w.hull, dtype=np.float64)
-        h2 = float(np.sum(hull[:, 0] * np.roll(hull[:, 1], -1) - np.roll(hull[:, 0], -1) * hull[:, 1]))
-        self._hull = np.ascontiguousarray(hull if h2 > 0 else hull[::-1])  # counter-clockwise
+        self._hull = np.ascontiguousarray(hull if _area2(hull) > 0 else hull[::-1])  # ccw
         self.S = np.zeros((6, E, m0 + K))  # the sweep's: the map, then A
         self.S[:, :, :m0] = ss
         self.SA_out = np.zeros((6, E, K))
@@ -324,7 +322,9 @@ class WatchBatch:
         try:
             a = np.array(actions, dtype=np.float64)
         except (TypeError, ValueError) as e:
-            raise ValueError(f"action must be a numeric array of shape (4,), got {actions!r}") from e
+            raise ValueError(
+                f"action must be a numeric array of shape (4,), got {actions!r}"
+            ) from e
         if a.shape != (k, 4):
             raise ValueError(f"action must have shape (4,), got shape {a.shape[1:]}")
         if self.fused and core_fused.clip_unit(a):
@@ -601,6 +601,11 @@ class WatchBatch:
     def __setstate__(self, st: dict) -> None:
         self.__dict__.update(st)
         shapely.prepare(self._robot_space)
+
+
+def _area2(v: np.ndarray) -> float:
+    """Twice the signed area of the polygon with vertices ``v (K, 2)`` (> 0: counter-clockwise)."""
+    return float(np.sum(v[:, 0] * np.roll(v[:, 1], -1) - np.roll(v[:, 0], -1) * v[:, 1]))
 
 
 class _Rows:

@@ -59,7 +59,6 @@ gives bitwise the same answers.
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import numpy as np
@@ -120,7 +119,9 @@ class WatchParallelEnv(_Base):
         "render_fps": 10,
     }
 
-    def __init__(self, scene: Any = "lab", *, render_mode: str | None = None, **kwargs: Any) -> None:
+    def __init__(
+        self, scene: Any = "lab", *, render_mode: str | None = None, **kwargs: Any
+    ) -> None:
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"render_mode must be None or 'rgb_array', got {render_mode!r}")
         self.batch = WatchBatch(1, scene, **kwargs)

@@ -66,7 +66,9 @@ class WatchVectorEnv(VectorEnv):
         else:
             mask = np.asarray(mask, dtype=bool)
             if mask.shape != (E,):
-                raise ValueError(f"reset_mask must have shape ({E},) (one per copy), got {mask.shape}")
+                raise ValueError(
+                    f"reset_mask must have shape ({E},) (one per copy), got {mask.shape}"
+                )
             idx = np.flatnonzero(mask)
         if seed is None:
             seeds: list[int | None] = [None] * E
