@@ -176,6 +176,8 @@ class WatchBatch:
         self.Q = np.zeros((E, 2))
         self.P = np.zeros((3, N))
         self.declared = np.zeros((E, A), dtype=np.int64)
+        #: A's hidden outcome per copy (-1 G, +1 H), set at its reset
+        self.truth = np.zeros(E, dtype=np.int64)
         self.collided = np.zeros(N, dtype=bool)
         self.sees = np.zeros(N, dtype=bool)
         self.inside = np.zeros(N, dtype=bool)
@@ -260,6 +262,7 @@ class WatchBatch:
             rng = self.rngs[e]
             traj = plan_trajectory(w, self.motion_cfg, rng)
             self.trajs[e] = traj
+            self.truth[e] = DECLARE_CODES[traj.outcome]
             self.TRJ[e] = traj.pos
             self.t[e] = 0
             self.Q[e] = traj.pos[0]
@@ -339,6 +342,23 @@ class WatchBatch:
         done (k,), decl_r (k, A))`` -- ``done``: the horizon is reached (every watcher is
         terminated)."""
         idx = np.asarray(idx, dtype=np.int64)
+        A = self.n_watchers
+        k = len(idx)
+        if self.fused:
+            wk.advance(idx, self.t, self.Q, self.TRJ)
+            self._set_a(idx)
+            self._move_sense(idx, act)
+            rew = np.empty((k, A))
+            decl_r = np.empty((k, A))
+            done = np.empty(k, dtype=bool)
+            wk.watch_rules(idx, A, act, self.t, self.max_steps, self.truth, self.declared,
+                           self.sees, self.seen_steps, self.team_seen_steps, self.see_reward,
+                           rew, decl_r, done)  # fmt: skip
+            if self.reward_mode == "team":
+                anyone = self.sees[self._rows(idx)].reshape(k, A).any(axis=1)
+                r = self.see_reward * anyone + np.mean(decl_r, axis=1)
+                rew = np.repeat(r[:, None], A, axis=1)
+            return rew, done, decl_r
         sel = slice(None) if len(idx) == self.n_envs else idx  # views when every copy steps
         t = self.t[sel]
         t += 1
@@ -346,8 +366,6 @@ class WatchBatch:
         self.Q[sel] = self.TRJ[idx, np.minimum(t, self.motion_cfg.move_steps)]
         self._set_a(idx)
         self._move_sense(idx, act)
-        A = self.n_watchers
-        k = len(idx)
         d = act[:, 3].reshape(k, A)
         lo, hi = d < -1 / 3, d > 1 / 3
         done = t >= self.max_steps
@@ -359,7 +377,7 @@ class WatchBatch:
             if new.any():
                 dec = np.where(new, want, dec)
                 self.declared[sel] = dec
-                truth = self._outcomes(idx)[:, None]
+                truth = self.truth[idx][:, None]
                 decl_r = np.where(new, np.where(want == truth, 1.0, -1.0), 0.0)
         if done.any():
             decl_r = np.where(done[:, None] & (dec == 0), -1.0, decl_r)
@@ -373,9 +391,6 @@ class WatchBatch:
             r = self.see_reward * anyone + np.mean(decl_r, axis=1)
             rew = np.repeat(r[:, None], A, axis=1)
         return rew, done, decl_r
-
-    def _outcomes(self, idx: np.ndarray) -> np.ndarray:
-        return np.array([DECLARE_CODES[self.trajs[e].outcome] for e in idx.tolist()])
 
     def _rows(self, idx: np.ndarray) -> np.ndarray | slice:
         A = self.n_watchers

@@ -384,6 +384,49 @@ if HAVE_NUMBA:  # pragma: no cover - exercised when numba is installed
                     out[r, m] = min(max(out[r, m], low[m]), np.float32(1.0))
 
     @njit
+    def advance(idx, t, Q, TRJ):
+        """One step of time for the copies ``idx``: ``t[e] += 1`` and A's reference point
+        ``Q[e]`` := ``TRJ[e, min(t[e], T)]`` (it rests after its last planned step)."""
+        last = TRJ.shape[1] - 1
+        for k in range(idx.shape[0]):
+            e = idx[k]
+            t[e] += 1
+            j = min(t[e], last)
+            Q[e, 0] = TRJ[e, j, 0]
+            Q[e, 1] = TRJ[e, j, 1]
+
+    @njit
+    def watch_rules(idx, nw, act, t, max_steps, truth, dec, sees, seen, team, see_reward,
+                    rew, decl_r, done):  # fmt: skip
+        """Declarations and rewards of the copies ``idx`` after their step (see
+        :meth:`.batch.WatchBatch.step_envs`): ``act[r, 3]`` declares G (< -1/3) or H (> 1/3)
+        when watcher ``r`` has not yet; +1 / -1 for a right / wrong declaration (``truth``:
+        -1 G, +1 H), -1 at the horizon for a watcher that never declared; the individual
+        reward ``see_reward * sees + that``; the counters of steps seen."""
+        for k in range(idx.shape[0]):
+            e = idx[k]
+            dn = t[e] >= max_steps
+            done[k] = dn
+            anyone = False
+            for w in range(nw):
+                r = k * nw + w
+                i = e * nw + w
+                d = act[r, 3]
+                want = -1 if d < -1 / 3 else (1 if d > 1 / 3 else 0)
+                dr = 0.0
+                if dec[e, w] == 0 and want != 0:
+                    dec[e, w] = want
+                    dr = 1.0 if want == truth[e] else -1.0
+                if dn and dec[e, w] == 0:
+                    dr = -1.0
+                decl_r[k, w] = dr
+                sv = sees[i]
+                seen[e, w] += 1 if sv else 0
+                anyone = anyone or sv
+                rew[k, w] = see_reward * (1.0 if sv else 0.0) + dr
+            team[e] += 1 if anyone else 0
+
+    @njit
     def _cone_side(ux, uy, vx, vy, wx, wy, ax, ay):
         """Whether ``a`` lies strictly inside the domain's angle at vertex ``v`` between its
         incoming edge ``u -> v`` and outgoing edge ``v -> w`` (interior on the left): 1 yes,
@@ -461,3 +504,4 @@ if HAVE_NUMBA:  # pragma: no cover - exercised when numba is installed
 
 else:  # pragma: no cover - without numba
     set_a = sees_filter = watch_step = obs_kernel = visible_from = None
+    advance = watch_rules = None

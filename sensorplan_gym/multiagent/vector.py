@@ -123,10 +123,7 @@ class WatchVectorEnv(VectorEnv):
         }
         if done is not None and done.any():
             rows = np.repeat(done, self.n_watchers)
-            truth = np.zeros(self.n_envs, dtype=np.int64)
-            ends = np.flatnonzero(done)
-            truth[ends] = b._outcomes(ends)
-            t_rows = np.repeat(truth, self.n_watchers)
+            t_rows = np.repeat(b.truth, self.n_watchers)
             infos["is_success"] = np.where(rows, b.declared.ravel() == t_rows, False)
             infos["a_ends_in_h"] = np.where(rows, t_rows == DECLARE_CODES["H"], False)
             infos["visible_fraction"] = np.where(rows, b.seen_steps.ravel() / b.max_steps, 0.0)
