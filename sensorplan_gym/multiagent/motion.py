@@ -140,19 +140,18 @@ def _execute(world: WatchWorld, cfg: MotionConfig, path: np.ndarray, rng) -> np.
     out[0] = nominal[0]
     emax = cfg.drift * world.diameter
     sigma = 0.25 * emax
-    clear = world.clearances(nominal[1:, 0], nominal[1:, 1])  # one vectorised query
-    rs = []
-    for t in range(1, T + 1):
-        r = min(emax, max(0.0, float(clear[t - 1]) - world.skin))
-        rs.append(r * min(1.0, (T - t) / cfg.settle_steps))
+    clear = world.clearances(nominal[1:, 0], nominal[1:, 1]).tolist()  # one query for all
+    skin, settle = world.skin, cfg.settle_steps
+    rs = [
+        min(emax, max(0.0, clear[t - 1] - skin)) * min(1.0, (T - t) / settle)
+        for t in range(1, T + 1)
+    ]
     # the steps with room to drift draw two normals each, in order: drawn at once
-    z = rng.normal(0.0, sigma, (sum(r > 0 for r in rs), 2))
-    zl = z.tolist()
-    drift = np.empty((T, 2))
+    zl = rng.normal(0.0, sigma, (sum(r > 0 for r in rs), 2)).tolist()
+    drift = []
     ex = ey = 0.0  # the drift e, in Python floats (the same IEEE operations as on arrays)
     k = 0
-    for t in range(1, T + 1):
-        r = rs[t - 1]
+    for r in rs:
         if r > 0:
             ex = ex + zl[k][0]
             ey = ey + zl[k][1]
@@ -164,8 +163,8 @@ def _execute(world: WatchWorld, cfg: MotionConfig, path: np.ndarray, rng) -> np.
             f = r / n
             ex = ex * f
             ey = ey * f
-        drift[t - 1, 0] = ex
-        drift[t - 1, 1] = ey
+        drift.append((ex, ey))
+    drift = np.array(drift)
     out[1:] = nominal[1:] + drift
     out[T] = nominal[T]
     return out

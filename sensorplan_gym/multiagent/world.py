@@ -326,7 +326,6 @@ class VisGraph:
     def shortest_path(self, a, b) -> np.ndarray | None:
         """Way points ``(N, 2)`` of a shortest path from ``a`` to ``b`` within the domain
         (``None`` if there is none, e.g. an end point outside it)."""
-        from scipy.sparse import coo_matrix
         from scipy.sparse.csgraph import dijkstra
 
         dom, nodes = self.domain, self.nodes
@@ -344,9 +343,7 @@ class VisGraph:
             rows += [np.full(len(idx), n + k), idx]
             cols += [idx, np.full(len(idx), n + k)]
             ws += [d, d]
-        M = coo_matrix(
-            (np.concatenate(ws), (np.concatenate(rows), np.concatenate(cols))), shape=(n + 2, n + 2)
-        ).tocsr()
+        M = _canonical_csr(np.concatenate(rows), np.concatenate(cols), np.concatenate(ws), n + 2)
         dist, pred = dijkstra(M, indices=n, return_predecessors=True)
         if not np.isfinite(dist[n + 1]):
             return None
@@ -354,6 +351,20 @@ class VisGraph:
         while path[-1] != n:
             path.append(int(pred[path[-1]]))
         return np.concatenate([nodes, ends])[path[::-1]]
+
+
+def _canonical_csr(rows: np.ndarray, cols: np.ndarray, data: np.ndarray, n: int):
+    """The ``n x n`` CSR matrix of the (distinct) entries ``(rows, cols, data)`` in canonical
+    form -- column indices sorted within each row --, the matrix
+    ``coo_matrix(...).tocsr()`` gives, built without its checks."""
+    from scipy.sparse import csr_matrix
+
+    order = np.lexsort((cols, rows))
+    indptr = np.zeros(n + 1, dtype=np.int32)
+    np.cumsum(np.bincount(rows, minlength=n), out=indptr[1:])
+    M = csr_matrix((data[order], cols[order].astype(np.int32), indptr), shape=(n, n))
+    M.has_sorted_indices = True
+    return M
 
 
 def _vertex_edges(domain: shapely.Geometry, nodes: np.ndarray):
