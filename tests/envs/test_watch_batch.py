@@ -245,3 +245,48 @@ def test_vector_env_api():
         venv.reset(options={"reset_mask": np.ones(8, dtype=bool)})
     with pytest.raises(ValueError, match="n_envs"):
         watch_v0.vector_env(0)
+
+
+@pytest.mark.skipif(not HAVE_NUMBA, reason="the compiled visibility test needs numba")
+@pytest.mark.parametrize("scene", ["lab", "edr", "warehouse"])
+def test_planner_visibility_agrees_with_covers(scene):
+    """A's planner asks the compiled exact test whether the segment from a point to each
+    vertex of its domain lies in the domain: where it answers, shapely's covers agrees."""
+    b = WatchBatch(1, scene)
+    b.seed_env(0, 0)
+    b.reset_envs(np.zeros(1, dtype=np.int64))
+    w = b.world
+    rng = np.random.default_rng(1)
+    counts = np.zeros(3, dtype=int)
+    for key, g in w._graphs.items():
+        n = len(g.nodes)
+        E, pin, pout, amb = g._edges
+        for k in range(25):
+            # free points, and (harder) the domain's own vertices
+            a = w.sample_free_config(rng) if k % 5 else g.nodes[rng.integers(n)].copy()
+            out = np.empty(n, dtype=np.int64)
+            wk.visible_from(float(a[0]), float(a[1]), g.nodes, E, pin, pout, amb, out)
+            segs = shapely.linestrings(np.stack([np.repeat(a[None], n, 0), g.nodes], axis=1))
+            ref = shapely.covers(g.domain, segs)
+            sure = out != wk.UNSURE
+            assert np.array_equal(ref[sure], out[sure] == 1), (scene, key, a)
+            counts += np.bincount(out, minlength=3)
+    assert counts[0] > 100 and counts[1] > 100 and counts[2] < 0.1 * counts.sum(), counts
+
+
+def test_canonical_csr_is_coo_tocsr():
+    from scipy.sparse import coo_matrix
+
+    from sensorplan_gym.multiagent.world import _canonical_csr
+
+    rng = np.random.default_rng(0)
+    n = 40
+    pairs = np.unique(rng.integers(0, n, (300, 2)), axis=0)
+    pairs = pairs[pairs[:, 0] != pairs[:, 1]]
+    perm = rng.permutation(len(pairs))
+    r, c = pairs[perm, 0], pairs[perm, 1]
+    d = rng.random(len(r))
+    want = coo_matrix((d, (r, c)), shape=(n, n)).tocsr()
+    got = _canonical_csr(r, c, d, n)
+    for name in ("indptr", "indices", "data"):
+        assert np.array_equal(getattr(want, name), getattr(got, name)), name
