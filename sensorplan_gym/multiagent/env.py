@@ -59,6 +59,7 @@ gives bitwise the same answers.
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -120,11 +121,51 @@ class WatchParallelEnv(_Base):
     }
 
     def __init__(
-        self, scene: Any = "lab", *, render_mode: str | None = None, **kwargs: Any
+        self,
+        scene: Any = "lab",
+        *,
+        n_watchers: int = 1,
+        model: str = "complete",
+        fov_deg: float | None = None,
+        max_range: float | None = None,
+        n_beams: int = 16,
+        noise: float = 0.0,
+        robot_radius: float = 0.0,
+        max_speed: float | None = None,
+        max_turn: float = math.pi / 8,
+        max_steps: int = 100,
+        move_steps: int = 50,
+        p_fail: float = 0.5,
+        drift: float = 0.02,
+        speed_noise: float = 0.2,
+        reward: str = "individual",
+        see_reward: float = 0.01,
+        random_start: bool = True,
+        render_mode: str | None = None,
     ) -> None:
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"render_mode must be None or 'rgb_array', got {render_mode!r}")
-        self.batch = WatchBatch(1, scene, **kwargs)
+        self.batch = WatchBatch(
+            1,
+            scene,
+            n_watchers=n_watchers,
+            model=model,
+            fov_deg=fov_deg,
+            max_range=max_range,
+            n_beams=n_beams,
+            noise=noise,
+            robot_radius=robot_radius,
+            max_speed=max_speed,
+            max_turn=max_turn,
+            max_steps=max_steps,
+            move_steps=move_steps,
+            p_fail=p_fail,
+            drift=drift,
+            speed_noise=speed_noise,
+            reward=reward,
+            see_reward=see_reward,
+            random_start=random_start,
+        )
         self.render_mode = render_mode
         self.possible_agents = [f"watcher_{i}" for i in range(self.batch.n_watchers)]
         self.agents: list[str] = []
