@@ -25,6 +25,13 @@ operations:
 :func:`obs_kernel` writes the observations (the leading ``8 + 4 B`` entries by
 :func:`~sensorplan_gym.core.fused._obs_row`, then the task's tail).  The numpy path computes
 the same expressions in the same order, so the two answer bitwise alike.
+
+:func:`visible_from` serves A's planner (:class:`~.world.VisGraph`): whether a segment from a
+point to a vertex of the planner's domain lies in the domain, with exact orientations.
+
+The kernels are cached on disk (``cache=True``) like the core's; numba's cache does not notice
+a change of a *called* kernel in another file (:mod:`sensorplan_gym.core.fused`), so after
+editing one there, clear ``sensorplan_gym/multiagent/__pycache__/kernels.*.nb*``.
 """
 
 from __future__ import annotations
