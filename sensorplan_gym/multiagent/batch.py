@@ -544,6 +544,7 @@ class WatchBatch:
         return np.clip(out, self._low, 1.0, out=out)
 
     def _observe_numpy(self, idx, tail, out) -> None:
+        """:func:`.kernels.obs_kernel` with numpy (the same expressions; clipped after)."""
         rows = self._rows(idx)
         envs = self._env_of(idx)
         A, B = self.n_watchers, self.n_beams
@@ -569,27 +570,19 @@ class WatchBatch:
         out[:, base] = tail[envs, 0]
         out[:, base + 1] = tail[envs, 1]
         out[:, base + 2] = tail[idx, 2:].ravel()
-        m = base + 3
-        X = x.reshape(-1, A)
-        Y = y.reshape(-1, A)
-        C = c.reshape(-1, A)
-        Sn = s.reshape(-1, A)
-        cols = []
+        # the other watchers of the copy, in the watcher's frame / diameter
+        X, Y, C, S = (v.reshape(-1, A) for v in (x, y, c, s))
+        view = out.reshape(-1, A, self.obs_dim)
         for w_ in range(A):
+            j = base + 3
             for o in range(A):
                 if o == w_:
                     continue
                 gx = X[:, o] - X[:, w_]
                 gy = Y[:, o] - Y[:, w_]
-                cols.append((w_, (C[:, w_] * gx + Sn[:, w_] * gy) * K[4],
-                             (C[:, w_] * gy - Sn[:, w_] * gx) * K[4]))  # fmt: skip
-        view = out.reshape(-1, A, self.obs_dim)
-        cnt = [0] * A
-        for w_, u, v in cols:
-            j = m + 2 * cnt[w_]
-            view[:, w_, j] = u
-            view[:, w_, j + 1] = v
-            cnt[w_] += 1
+                view[:, w_, j] = (C[:, w_] * gx + S[:, w_] * gy) * K[4]
+                view[:, w_, j + 1] = (C[:, w_] * gy - S[:, w_] * gx) * K[4]
+                j += 2
 
     # ---- one copy, for the PettingZoo env and rendering -------------------------------------
     def pose(self, i: int) -> tuple[float, float, float]:
