@@ -329,7 +329,7 @@ class WatchBatch:
                 f"action must be a numeric array of shape (4,), got {actions!r}"
             ) from e
         if a.shape != (k, 4):
-            raise ValueError(f"action must have shape (4,), got shape {a.shape[1:]}")
+            raise ValueError(f"actions must have shape ({k}, 4) (a row per watcher), got {a.shape}")
         if self.fused and core_fused.clip_unit(a):
             return a
         if not np.isfinite(a).all():
