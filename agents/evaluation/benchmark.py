@@ -17,7 +17,11 @@ Procedural splits of tasks with a start (Navigate, Recognize) draw a start per e
 * ``test`` -- procedural scenes from the disjoint pool of seed :data:`TEST_POOL_SEED`, never
   trained on;
 * ``ood`` -- every bundled scene (``lab``, ``edr``, ``corridor``, ``warehouse``), one split
-  each (``ood:lab`` ...): hand-made maps outside the generator's distribution.
+  each (``ood:lab`` ...): hand-made maps outside the generator's distribution, from a start
+  drawn per episode (``random_start=True``) where the task has one;
+* ``real`` -- every bundled real floor plan (:data:`sensorplan_gym.REAL_SCENES`, public ROS
+  maps of the Willow Garage office and the LSE arena), one split each (``real:willow_north``
+  ...); not in the default splits (give ``--splits train test ood real``).
 
 The difficulty knob ``--difficulty D`` (default :data:`DEFAULT_DIFFICULTY`) is the env kwarg
 ``min_start_distance``: procedural scenes start at least ``D`` scene diameters away from the
@@ -114,7 +118,7 @@ def splits(
     :data:`TRAIN_POOL_SEED` at ``difficulty``.  ``level`` (``"easy"``, ``"medium"``,
     ``"hard"``: :data:`geometry.families.DIFFICULTIES`) draws the procedural splits from that
     level's scene family, at its ``min_start_distance`` unless ``difficulty`` is given."""
-    from sensorplan_gym import BUNDLED_SCENES
+    from sensorplan_gym import BUNDLED_SCENES, REAL_SCENES
 
     hard: dict = {}
     if level is not None:
@@ -125,26 +129,32 @@ def splits(
         hard["max_scene_tries"] = 200
     if needs_start:  # a start drawn per episode: 100 episodes are not 64 scene-start pairs
         hard = {"random_start": True, **hard}
+    # bundled and real scenes: a start drawn per episode too (their fixed start is one episode)
+    start = {"random_start": True} if needs_start else {}
     out: dict[str, dict] = {}
     for name in names:
         if name == "train" and train_pool is not None:
             pool = {k: v for k, v in train_pool.items() if v is not None}
             if not needs_start:
                 pool.pop("min_start_distance", None)
-            start = {"random_start": True} if needs_start else {}
             out[name] = {"scene": "random", **start, **pool}
         elif name == "train":
             out[name] = {"scene": "random", "scene_pool_seed": TRAIN_POOL_SEED, **hard}
         elif name == "test":
             out[name] = {"scene": "random", "scene_pool_seed": TEST_POOL_SEED, **hard}
         elif name == "ood":
-            out.update({f"ood:{s}": {"scene": s} for s in BUNDLED_SCENES})
+            out.update({f"ood:{s}": {"scene": s, **start} for s in BUNDLED_SCENES})
+        elif name == "real":
+            out.update({f"real:{s[5:]}": {"scene": s, **start} for s in REAL_SCENES})
         elif name.startswith("ood:") and name[4:] in BUNDLED_SCENES:
-            out[name] = {"scene": name[4:]}
+            out[name] = {"scene": name[4:], **start}
+        elif name.startswith("real:") and f"real/{name[5:]}" in REAL_SCENES:
+            out[name] = {"scene": f"real/{name[5:]}", **start}
         else:
             raise ValueError(
-                f"unknown split {name!r}: use train, test, ood or ood:<scene> "
-                f"({', '.join(BUNDLED_SCENES)})"
+                f"unknown split {name!r}: use train, test, ood, ood:<scene> "
+                f"({', '.join(BUNDLED_SCENES)}), real or real:<map> "
+                f"({', '.join(s[5:] for s in REAL_SCENES)})"
             )
     return out
 

@@ -18,14 +18,27 @@ from geometry import Scene
 from geometry.formats import SCENE_SUFFIXES, load_scene_file, scene_from_data
 from geometry.occupancy import ROS_MAP_SUFFIXES, scene_from_ros_map
 
-__all__ = ["BUNDLED_SCENES", "SCENE_DIR", "SCENE_SUFFIXES", "bundled_scene_path", "load_scene"]
+__all__ = [
+    "BUNDLED_SCENES",
+    "REAL_SCENES",
+    "SCENE_DIR",
+    "SCENE_SUFFIXES",
+    "bundled_scene_path",
+    "load_scene",
+]
 
 SCENE_DIR = Path(__file__).resolve().parent.parent / "scenes"
+#: the hand-made bundled scenes
 BUNDLED_SCENES = tuple(sorted(p.stem for p in SCENE_DIR.glob("*.json")))
+#: the bundled real floor plans (public ROS maps, ``scenes/real/provenance.json``), by the
+#: names ``real/<stem>``
+REAL_SCENES = tuple(
+    f"real/{p.stem}" for p in sorted((SCENE_DIR / "real").glob("*.json")) if p.stem != "provenance"
+)
 
 
 def bundled_scene_path(name: str) -> Path:
-    """Path of the bundled scene JSON ``name`` (e.g. ``"lab"``)."""
+    """Path of the bundled scene JSON ``name`` (e.g. ``"lab"`` or ``"real/willow_north"``)."""
     return SCENE_DIR / f"{name}.json"
 
 
@@ -33,7 +46,8 @@ def load_scene(spec: str | PathLike[str] | Scene | Mapping, *, name: str | None 
     """A validated :class:`geometry.Scene` from
 
     * a bundled scene name (:data:`BUNDLED_SCENES`: ``lab``, ``edr``, ``corridor``,
-      ``warehouse``);
+      ``warehouse``; :data:`REAL_SCENES`: ``real/willow_north``, ``real/willow_south``,
+      ``real/lse_arena``);
     * a path to a scene file: ``.json`` (scene JSON, or GeoJSON when the object has a
       ``"type"`` member), ``.geojson`` or ``.wkt`` (see :mod:`geometry.formats`);
     * a dict: scene JSON, or a GeoJSON FeatureCollection (it has a ``"type"`` member);
@@ -51,7 +65,7 @@ def load_scene(spec: str | PathLike[str] | Scene | Mapping, *, name: str | None 
         return scene_from_data(spec, name=name)
     else:
         s = str(spec)
-        if s in BUNDLED_SCENES:
+        if s in BUNDLED_SCENES or s in REAL_SCENES:
             scene = Scene.load(bundled_scene_path(s))
         else:
             p = Path(s)

@@ -77,8 +77,10 @@ def test_procedural_splits_draw_a_start_per_episode_and_count_distinct_episodes(
     test, corridor = res["rows"]
     # 4 pool scenes, 8 episodes: every episode has its own start
     assert test["distinct_episodes"] == 8
-    # the bundled scene keeps its start: one distinct episode, however many are played
-    assert corridor["distinct_episodes"] == 1
+    # bundled scenes too: a start per episode, not the scene's one fixed start
+    assert corridor["distinct_episodes"] == 8
+    assert splits(["ood:lab"], 0.3, needs_start=True)["ood:lab"]["random_start"] is True
+    assert "random_start" not in splits(["ood"], 0.3, needs_start=False)["ood:lab"]
 
 
 def test_wilson_interval_is_sized_by_distinct_episodes():
