@@ -14,10 +14,15 @@ import shapely
 from ._shapes import union_all
 from ._vis import TAU, Domain, Gaps, clean_polygon, gaps_many
 
-__all__ = ["ENV", "UNWANTED", "WANTED", "weak_visibility"]
+__all__ = ["CONTACT_REL", "ENV", "UNWANTED", "WANTED", "snap_to_boundary", "weak_visibility"]
 
 #: Segment tags inside the visibility domain.
 ENV, WANTED, UNWANTED = 0, 1, 2
+
+#: A target vertex within this distance (times the domain's scale: ``TOL_REL`` of the
+#: scene's diameter in the local frame) of the free space's boundary *touches* it and is
+#: moved onto it (docs/DESIGN.md, "Contacts").
+CONTACT_REL = 1e-9
 
 
 def weak_visibility(
@@ -39,6 +44,7 @@ def weak_visibility(
     Union of the visibility triangles (shapely geometry, world frame), not yet
     clipped against the target itself.
     """
+    ring, wanted = snap_to_boundary(env, ring, wanted)
     dom = env.with_ring(ring, UNWANTED, np.where(wanted, WANTED, UNWANTED))
     fans: list[shapely.Geometry] = []
     # 1. anchors on the target: endpoints of wanted pieces, seen from the front
@@ -89,6 +95,99 @@ def weak_visibility(
     if not fans:
         return shapely.Polygon()
     return _union(fans, n_first=n_direct)
+
+
+def snap_to_boundary(
+    env: Domain, ring: np.ndarray, wanted: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """The target ``ring`` with its contacts with the free space's boundary made exact
+    (docs/DESIGN.md, "Contacts"); ``wanted`` (one flag per segment ``ring[i] ->
+    ring[i+1]``) follows.  Touching means within ``tol = CONTACT_REL * env.scale``:
+
+    1. a ring vertex that touches a boundary vertex is moved onto it; else one that
+       touches a boundary segment is moved onto the foot of its perpendicular;
+    2. a boundary vertex that touches the interior of a ring segment is inserted into the
+       ring (the segment is split there, both halves keep its flag);
+    3. a ring segment whose two ends and midpoint all touch the boundary lies *flush*
+       along it: it is covered (an obstacle or a wall lies on it) and is not wanted.
+
+    Segments that collapse to a point are dropped.
+
+    Why: a target placed flush against an obstacle or a wall lands up to ~1e-11 of the
+    scene inside it or outside it, as the rounding of the pose and of the frame falls
+    (issue 26 items 2, 5, 9).  A fan anchored at a vertex inside an obstacle is empty
+    (every ray toward the free side meets the obstacle's edge at once), so the placements
+    that see the exposed middle of an edge whose two ends are flush were lost; a vertex
+    just outside saw, through the sub-tolerance gap, a whole half-plane in front of the
+    covered edge.  After 1-3 every contact is decided by exact coincidence: the fans of
+    vertices on the boundary obey the rules for viewpoints on it
+    (:func:`geometry._vis.gaps_many`: the free wedge at a vertex, the free side of a
+    segment), and a covered edge is seen by no one, whichever side the rounding put it
+    on.  The moves are at most ``tol``, below the tolerance of every answer.
+    """
+    tol = CONTACT_REL * env.scale
+    ring = np.asarray(ring, dtype=float)
+    wanted = wanted0 = np.asarray(wanted, dtype=bool)
+    if len(env.seg) == 0 or len(ring) < 3:
+        return ring, wanted
+    out = ring.copy()
+    rows = np.arange(len(out))
+    # 1. vertices onto the boundary (a boundary vertex first, else a segment's foot)
+    dv = np.hypot(*(env.vert[None, :, :] - out[:, None, :]).transpose(2, 0, 1))
+    jv = np.argmin(dv, axis=1)
+    on_v = dv[rows, jv] <= tol
+    foot, ds = _feet(env.seg, out)
+    js = np.argmin(ds, axis=1)
+    on_s = ~on_v & (ds[rows, js] <= tol)
+    out[on_v] = env.vert[jv[on_v]]
+    out[on_s] = foot[rows[on_s], js[on_s]]
+    touching = on_v | on_s
+    # 2. boundary vertices on the ring's segments
+    p0, p1 = out, np.roll(out, -1, axis=0)
+    e = p1 - p0
+    ll = np.maximum((e * e).sum(axis=1), 1e-300)
+    w = env.vert[None, :, :] - p0[:, None, :]  # (m, V, 2)
+    t = (w * e[:, None, :]).sum(axis=2) / ll[:, None]
+    length = np.sqrt(ll)[:, None]
+    off = np.abs(e[:, None, 0] * w[..., 1] - e[:, None, 1] * w[..., 0]) / length
+    seg_i, vert_j = np.nonzero((off <= tol) & (t * length > tol) & ((1.0 - t) * length > tol))
+    moved = touching.any() or len(seg_i) > 0
+    if not moved:
+        return ring, wanted
+    if len(seg_i):
+        # merge: original vertex i sorts at (i, -1), an inserted one at (i, t)
+        key_i = np.concatenate([rows, seg_i])
+        key_t = np.concatenate([np.full(len(rows), -1.0), t[seg_i, vert_j]])
+        pts = np.concatenate([out, env.vert[vert_j]])
+        flags = np.concatenate([wanted, wanted[seg_i]])
+        on_b = np.concatenate([touching, np.ones(len(seg_i), dtype=bool)])
+        order = np.lexsort((key_t, key_i))
+        out, wanted, touching = pts[order], flags[order], on_b[order]
+    keep = np.any(out != np.roll(out, -1, axis=0), axis=1)
+    out, wanted, touching = out[keep], wanted[keep], touching[keep]
+    if len(out) < 3:  # pragma: no cover - a target thinner than tol (rejected at load)
+        return ring, np.asarray(wanted0, dtype=bool)
+    # 3. flush segments: both ends and the midpoint on the boundary
+    ends = touching & np.roll(touching, -1)
+    if ends.any():
+        mid = 0.5 * (out[ends] + np.roll(out, -1, axis=0)[ends])
+        _, dm = _feet(env.seg, mid)
+        flush = np.zeros(len(out), dtype=bool)
+        flush[np.flatnonzero(ends)] = dm.min(axis=1) <= tol
+        wanted = wanted & ~flush
+    return out, wanted
+
+
+def _feet(seg: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """For points ``p`` (n, 2) and segments ``seg`` (E, 4): the nearest point of every
+    segment to every point, (n, E, 2), and its distance, (n, E)."""
+    a = seg[:, :2]
+    e = seg[:, 2:] - a
+    ll = np.maximum((e * e).sum(axis=1), 1e-300)
+    d = p[:, None, :] - a[None, :, :]
+    t = np.clip((d * e[None]).sum(axis=2) / ll, 0.0, 1.0)
+    foot = a[None] + t[..., None] * e[None]
+    return foot, np.hypot(*(p[:, None, :] - foot).transpose(2, 0, 1))
 
 
 def _union(polys: list[shapely.Geometry], n_first: int) -> shapely.Geometry:
