@@ -197,10 +197,18 @@ def build_parser() -> argparse.ArgumentParser:
         "--difficulty",
         type=float,
         default=None,
-        help="min_start_distance of the procedural splits, in scene diameters (default 0.35)",
+        help="min_start_distance of the procedural splits, in scene diameters (default 0.35, "
+        "or the --level's)",
     )
     bm.add_argument(
-        "--splits", nargs="+", default=None, help="train, test, ood, ood:<scene> (default: all)"
+        "--level",
+        choices=("easy", "medium", "hard"),
+        default=None,
+        help="draw the procedural splits from this benchmark level's scene family "
+        "(geometry.families.DIFFICULTIES; default: the plain random-scene generator)",
+    )
+    bm.add_argument(
+        "--splits", nargs="+", default=None, help="train, test, ood, ood:<scene>, real, real:<map> (default: train test ood)"
     )
     bm.add_argument("--env-kwargs", type=_json_dict, default=None)
     bm.add_argument(
@@ -501,8 +509,13 @@ def main(argv: list[str] | None = None) -> int:
                 args.policies,
                 episodes=args.episodes,
                 seed=args.seed,
-                difficulty=DEFAULT_DIFFICULTY if args.difficulty is None else args.difficulty,
+                difficulty=(
+                    args.difficulty
+                    if args.difficulty is not None
+                    else (None if args.level else DEFAULT_DIFFICULTY)
+                ),
                 split_names=args.splits,
+                level=args.level,
                 env_kwargs=args.env_kwargs,
                 out=args.out,
                 deterministic=not args.stochastic,

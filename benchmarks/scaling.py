@@ -5,7 +5,8 @@
 
 For scenes from :func:`geometry.generate.scene_with_edges` (``seed=1``) with 100, 200,
 400, 800, 1,600, 3,200 and 8,000 environment edges, and for the bundled large office
-floor (``sensorplan_gym/scenes/large/office_floor.json``), it times with
+floor (``sensorplan_gym/scenes/large/office_floor.json``) and the real maps of 100-300
+edges (``sensorplan_gym/scenes/real/willow_*.json``, public ROS floor plans), it times with
 ``time.perf_counter`` (median over ``--reps`` warm calls on one Scene, the per-scene
 structures already built):
 
@@ -54,6 +55,10 @@ OFFICE = (
     / "large"
     / "office_floor.json"
 )
+
+
+#: the bundled real floor plans of 100-300 edges (benchmarks.make_real_maps)
+REAL = sorted(OFFICE.parent.parent.joinpath("real").glob("willow_*.json"))
 
 
 def _pose(s: Scene) -> tuple[float, float, float]:
@@ -153,7 +158,12 @@ def _brute(fn: Callable[[], object], reps: int, budget: float) -> float:
 
 
 def run(
-    edges: tuple[int, ...], reps: int, budget: float, office: bool = True, brute_max: int = 1600
+    edges: tuple[int, ...],
+    reps: int,
+    budget: float,
+    office: bool = True,
+    brute_max: int = 1600,
+    real: bool = True,
 ) -> dict[str, Any]:
     """Time every case; returns the rows (seconds; ``None`` where not measured) and, with the
     office floor, the env timings."""
@@ -165,6 +175,9 @@ def run(
     if office and OFFICE.exists():
         s = Scene.load(OFFICE)
         cases.append(("office floor", len(s.bounds) + sum(len(o) for o in s.obstacles), s))
+    for path in REAL if real else ():
+        s = Scene.load(path)
+        cases.append((s.name, len(s.bounds) + sum(len(o) for o in s.obstacles), s))
     for label, n, s in cases:
         anchor = _anchor(s)
         row: dict[str, Any] = {"scene": label, "edges": n, "anchor_s": anchor, "query_s": {}}
@@ -320,6 +333,7 @@ def main(argv: list[str] | None = None) -> None:
         "--budget", type=float, default=20.0, help="seconds per query and scene (fewer reps)"
     )
     ap.add_argument("--no-office", action="store_true", help="skip the bundled office floor")
+    ap.add_argument("--no-real", action="store_true", help="skip the bundled real maps")
     ap.add_argument(
         "--brute-max", type=int, default=1600, help="largest scene also timed without the index"
     )
@@ -334,7 +348,14 @@ def main(argv: list[str] | None = None) -> None:
     data = {
         "command": _results.command("benchmarks.scaling", argv),
         "machine": _results.machine(),
-        **run(edges, args.reps, args.budget, office=not args.no_office, brute_max=args.brute_max),
+        **run(
+            edges,
+            args.reps,
+            args.budget,
+            office=not args.no_office,
+            brute_max=args.brute_max,
+            real=not args.no_real,
+        ),
     }
     if args.swept:
         data["swept"] = swept_ab()

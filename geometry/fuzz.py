@@ -22,7 +22,10 @@ demands equality up to the output's rounding.
   (``conservative=True``) ⊆ stationary partial, violated by more than 1e-8 D^2;
 * ``unsafe``: a sampled member of a complete region that an independent segment test
   finds blind to part of the target (points within 1e-6 D of the region's boundary are
-  skipped);
+  skipped); a sampled member of the stationary partial region that sees no sampled point
+  of the target's outline, contacts blocking (points within 1e-2 D skipped);
+* ``missed``: a sampled non-member of the stationary partial region that sees a sampled
+  outline point along a segment 1e-7 D clear of everything (issue 26 items 2, 5);
 * ``translation``: the region of the scene translated by an exact offset (a multiple of a
   power of two near the scene's size, 10 to 1e5 sizes away), translated
   back, differs from the original by more than 1e-9 D^2;
@@ -446,6 +449,68 @@ def _sees_whole(obs: shapely.Geometry, walls: shapely.Geometry, hull: np.ndarray
     return bool(shapely.covers(walls, lines).all())
 
 
+def _clear_lines(
+    p: np.ndarray, pts: np.ndarray, obs: shapely.Geometry, walls: shapely.Geometry,
+    target: shapely.Geometry, back: float,
+) -> np.ndarray:
+    """Per target point ``pts[k]``: the segment from ``p`` to it, ending ``back`` short of
+    it, lies in ``walls``, misses ``obs`` and misses ``target`` (self-occlusion)."""
+    d = pts - p
+    ln = np.maximum(np.hypot(d[:, 0], d[:, 1]), 1e-300)
+    end = pts - d * (back / ln)[:, None]
+    full = shapely.linestrings(np.stack([np.broadcast_to(p, pts.shape), pts], axis=1))
+    short = shapely.linestrings(np.stack([np.broadcast_to(p, pts.shape), end], axis=1))
+    ok = shapely.covers(walls, full)
+    if not obs.is_empty:
+        ok &= ~shapely.intersects(full, obs)
+    return ok & ~shapely.intersects(short, target)
+
+
+def _outline_points(poly: shapely.Polygon, per_edge: int = 64) -> np.ndarray:
+    """Points along every edge of ``poly``'s outline, its vertices excluded."""
+    c = np.asarray(poly.exterior.coords)[:, :2]
+    f = (np.arange(per_edge) + 0.5) / per_edge
+    return (c[:-1, None, :] + f[None, :, None] * (c[1:] - c[:-1])[:, None, :]).reshape(-1, 2)
+
+
+def _check_partial_points(
+    s: Scene, q_at: tuple, p_at: shapely.Geometry, rng: np.random.Generator, out: list
+) -> None:
+    """Independent point tests of the stationary partial region (issue 26 items 2, 5, 9):
+
+    * ``unsafe``: a member (1e-2 D inside) from which no sampled point of the target's
+      outline (nor a vertex farther than the tolerance from everything) is visible, a
+      contact counting as a blocker (a segment that touches an obstacle, or leaves the
+      walls, is blocked): such a placement sees the target at most through a gap
+      narrower than the scene's tolerance (``fuzz-variance-P_stat`` saw a whole
+      half-plane through one);
+    * ``missed``: a non-member (1e-6 D outside) that sees a sampled outline point along a
+      segment clear of every obstacle and wall by 1e-7 D (``fuzz-disagree-P_stat-*``: the
+      exposed middle of an edge whose two ends are flush)."""
+    D = s.diameter
+    tgt = s.target_at(*q_at)
+    pts = _outline_points(tgt)
+    raw_obs, raw_walls = s.obstacle_union, s.bounds_geom
+    # the target's vertices too, but only those that touch nothing: a vertex seen through a
+    # gap wider than the tolerance (6-decimal inputs leave 1e-8 D) is seen
+    verts = np.asarray(tgt.exterior.coords)[:-1, :2]
+    edge = shapely.union(shapely.boundary(raw_obs), raw_walls.exterior)
+    free_v = verts[shapely.distance(shapely.points(verts), edge) > s.tol]
+    look = np.vstack([pts, free_v])
+    for p in _sample(p_at, 8, rng, 1e-2 * D):
+        if not _clear_lines(p, look, raw_obs, raw_walls, tgt, 1e-9 * D).any():
+            out.append(Finding("unsafe", "partial at", f"member {tuple(p)} sees no outline point"))
+            break
+    m = 1e-7 * D
+    grown = s.obstacle_union.buffer(m) if not s.obstacle_union.is_empty else raw_obs
+    inner = s.bounds_geom.buffer(-m, join_style="mitre")
+    rest = shapely.difference(shapely.difference(s.free_space, tgt), p_at)
+    for p in _sample(rest, 12, rng, 1e-6 * D):
+        if _clear_lines(p, pts, grown, inner, tgt, m).any():
+            out.append(Finding("missed", "partial at", f"{tuple(p)} sees the target, not in it"))
+            break
+
+
 def _sample(g: shapely.Geometry, n: int, rng: np.random.Generator, margin: float) -> np.ndarray:
     core = g.buffer(-margin)
     if core.is_empty:
@@ -527,6 +592,8 @@ def check_scene(
         blind = sum(not _sees_whole(obs, walls, hull, p) for p in pts)
         if blind:
             out.append(Finding("unsafe", "complete at", f"{blind} of {len(pts)} members blind"))
+    if p_at is not None:
+        _check_partial_points(s, q_at, p_at, rng, out)
     c_in = run("complete in", lambda: complete_region(s, target_in="goal", theta=theta))
     c_any = run("complete any", lambda: complete_region(s, target_in="goal", theta=None))
     incl(c_any, c_in, "any orientation ⊆ fixed orientation")

@@ -11,13 +11,18 @@ from __future__ import annotations
 import numpy as np
 import shapely
 
-from ._shapes import union_all
+from ._shapes import cross, union_all
 from ._vis import TAU, Domain, Gaps, clean_polygon, gaps_many
 
-__all__ = ["ENV", "UNWANTED", "WANTED", "weak_visibility"]
+__all__ = ["CONTACT_REL", "ENV", "UNWANTED", "WANTED", "snap_to_boundary", "weak_visibility"]
 
 #: Segment tags inside the visibility domain.
 ENV, WANTED, UNWANTED = 0, 1, 2
+
+#: A target vertex within this distance (times the domain's scale: ``TOL_REL`` of the
+#: scene's diameter in the local frame) of the free space's boundary *touches* it and is
+#: moved onto it (docs/DESIGN.md, "Contacts").
+CONTACT_REL = 1e-9
 
 
 def weak_visibility(
@@ -39,6 +44,7 @@ def weak_visibility(
     Union of the visibility triangles (shapely geometry, world frame), not yet
     clipped against the target itself.
     """
+    ring, wanted = snap_to_boundary(env, ring, wanted)
     dom = env.with_ring(ring, UNWANTED, np.where(wanted, WANTED, UNWANTED))
     fans: list[shapely.Geometry] = []
     # 1. anchors on the target: endpoints of wanted pieces, seen from the front
@@ -62,7 +68,8 @@ def weak_visibility(
     n_direct = len(fans)
     # 2. grazing anchors: reflex vertices v of the free space around the target;
     #    first the directions in which v sees a wanted piece ...
-    v = dom.vert[dom.reflex]
+    v_idx = np.flatnonzero(dom.reflex)
+    v = dom.vert[v_idx]
     if len(v):
         rel = np.arctan2(ring[None, :, 1] - v[:, None, 1], ring[None, :, 0] - v[:, None, 0])
         centre = ring.mean(axis=0)
@@ -73,8 +80,17 @@ def weak_visibility(
         hi = np.where(on_target, -np.inf, rel).max(axis=1)
         ok = hi - lo > 1e-12
         v, sectors = v[ok], np.stack([base[ok] + lo[ok], hi[ok] - lo[ok]], axis=1)
-        g, off = gaps_many(dom, v, sectors=sectors, flat=True)
+        # a line through a pinch (polygons touching at v) passes between them: blocked
+        arcs = _pinch_arcs(dom, v_idx[ok])
+        extra = None
+        if arcs is not None:  # split the gaps where a line through v starts to separate
+            a0, a1 = arcs[..., 0], arcs[..., 0] + arcs[..., 1]
+            extra = np.concatenate([a0, a1, a0 - np.pi, a1 - np.pi], axis=1)
+        g, off = gaps_many(dom, v, sectors=sectors, extra=extra, flat=True)
         sees = (g.seg >= 0) & (dom.seg_tag[np.maximum(g.seg, 0)] == WANTED)
+        if arcs is not None:
+            owner = np.searchsorted(off, np.arange(len(g.lo)), side="right") - 1
+            sees &= _grazes(arcs[owner], 0.5 * (g.lo + g.hi))
         back_q, back_sec = [], []
         for k in np.unique(np.searchsorted(off, np.flatnonzero(sees), side="right") - 1):
             gk = g.part(off[k], off[k + 1])
@@ -89,6 +105,208 @@ def weak_visibility(
     if not fans:
         return shapely.Polygon()
     return _union(fans, n_first=n_direct)
+
+
+def _pinch_arcs(dom: Domain, idx: np.ndarray) -> np.ndarray | None:
+    """At each domain vertex ``dom.vert[idx]`` where two or more domain vertices coincide
+    (a *pinch*: two obstacles, or the target and an obstacle, touching at a vertex), the
+    arcs of directions that enter one of them, as (n, K, 2) ``(start, width)`` (NaN rows
+    and padding elsewhere); ``None`` when none of them is a pinch."""
+    if len(idx) == 0:
+        return None
+    _, inv, cnt = np.unique(dom.vert, axis=0, return_inverse=True, return_counts=True)
+    inv = inv.reshape(-1)
+    group = inv[idx]
+    hit = np.flatnonzero(cnt[group] >= 2)
+    if len(hit) == 0:
+        return None
+    wedge = dom.vert_wedge
+    out = np.full((len(idx), int(cnt.max()), 2), np.nan)
+    for r in hit:  # pinches only (contacts are few)
+        w = wedge[inv == group[r]]
+        out[r, : len(w), 0] = w[:, 0] + w[:, 1]
+        out[r, : len(w), 1] = TAU - w[:, 1]
+    return out
+
+
+def _grazes(arcs: np.ndarray, phi: np.ndarray) -> np.ndarray:
+    """Does the line through a pinch at direction ``phi`` (n,) leave all the touching
+    polygons' arcs ``arcs`` (n, K, 2) on one side?  A line with polygons on both sides
+    passes between them through their contact point only: a gap of zero width, which
+    blocks (docs/DESIGN.md, "Contacts").  Rows without arcs (NaN) pass."""
+    start, width = arcs[..., 0], arcs[..., 1]
+    eps = 1e-12
+    with np.errstate(invalid="ignore"):
+        left = ((start - phi[:, None]) % TAU) + width <= np.pi + eps
+        right = ((start - phi[:, None] - np.pi) % TAU) + width <= np.pi + eps
+    none = np.isnan(start)
+    return (left | none).all(axis=1) | (right | none).all(axis=1)
+
+
+def snap_to_boundary(
+    env: Domain, ring: np.ndarray, wanted: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """The target ``ring`` with its contacts with the free space's boundary made exact
+    (docs/DESIGN.md, "Contacts"); ``wanted`` (one flag per segment ``ring[i] ->
+    ring[i+1]``) follows.  Touching means within ``tol = CONTACT_REL * env.scale``:
+
+    1. a ring vertex that touches a boundary vertex is moved onto it; else one that
+       touches a boundary segment is moved onto the foot of its perpendicular;
+    2. a boundary vertex that touches the interior of a ring segment is inserted into the
+       ring (the segment is split there, both halves keep its flag);
+    3. the parts of the ring's segments that touch the boundary (an obstacle or a wall
+       lies on them, flush or at a contact point) are covered: the segment is cut at
+       their ends and they are not wanted.
+
+    Segments that collapse to a point are dropped.
+
+    Why: a target placed flush against an obstacle or a wall lands up to ~1e-11 of the
+    scene inside it or outside it, as the rounding of the pose and of the frame falls
+    (issue 26 items 2, 5, 9).  A fan anchored at a vertex inside an obstacle is empty
+    (every ray toward the free side meets the obstacle's edge at once), so the placements
+    that see the exposed middle of an edge whose two ends are flush were lost; a vertex
+    just outside saw, through the sub-tolerance gap, a whole half-plane in front of the
+    covered edge.  After 1-3 every contact is decided by exact coincidence: the fans of
+    vertices on the boundary obey the rules for viewpoints on it
+    (:func:`geometry._vis.gaps_many`: the free wedge at a vertex, the free side of a
+    segment), and a covered edge is seen by no one, whichever side the rounding put it
+    on.  The moves are at most ``tol``, below the tolerance of every answer.
+    """
+    tol = CONTACT_REL * env.scale
+    ring = np.asarray(ring, dtype=float)
+    wanted = wanted0 = np.asarray(wanted, dtype=bool)
+    if len(env.seg) == 0 or len(ring) < 3:
+        return ring, wanted
+    out = ring.copy()
+    rows = np.arange(len(out))
+    # 1. vertices onto the boundary (a boundary vertex first, else a segment's foot)
+    dv = np.hypot(*(env.vert[None, :, :] - out[:, None, :]).transpose(2, 0, 1))
+    jv = np.argmin(dv, axis=1)
+    on_v = dv[rows, jv] <= tol
+    foot, ds = _feet(env.seg, out)
+    js = np.argmin(ds, axis=1)
+    on_s = ~on_v & (ds[rows, js] <= tol)
+    out[on_v] = env.vert[jv[on_v]]
+    out[on_s] = foot[rows[on_s], js[on_s]]
+    # 2. boundary vertices on the ring's segments
+    p0, p1 = out, np.roll(out, -1, axis=0)
+    e = p1 - p0
+    ll = np.maximum((e * e).sum(axis=1), 1e-300)
+    w = env.vert[None, :, :] - p0[:, None, :]  # (m, V, 2)
+    t = (w * e[:, None, :]).sum(axis=2) / ll[:, None]
+    length = np.sqrt(ll)[:, None]
+    off = np.abs(e[:, None, 0] * w[..., 1] - e[:, None, 1] * w[..., 0]) / length
+    seg_i, vert_j = np.nonzero((off <= tol) & (t * length > tol) & ((1.0 - t) * length > tol))
+    if not (on_v | on_s).any() and len(seg_i) == 0:
+        return ring, wanted
+    if len(seg_i):
+        # merge: original vertex i sorts at (i, -1), an inserted one at (i, t)
+        key_i = np.concatenate([rows, seg_i])
+        key_t = np.concatenate([np.full(len(rows), -1.0), t[seg_i, vert_j]])
+        pts = np.concatenate([out, env.vert[vert_j]])
+        flags = np.concatenate([wanted, wanted[seg_i]])
+        order = np.lexsort((key_t, key_i))
+        out, wanted = pts[order], flags[order]
+    keep = np.any(out != np.roll(out, -1, axis=0), axis=1)
+    out, wanted = out[keep], wanted[keep]
+    if len(out) < 3:  # pragma: no cover - a target thinner than tol (rejected at load)
+        return ring, np.asarray(wanted0, dtype=bool)
+    # 3. the covered parts of the ring's segments (within tol of the boundary): cut there,
+    #    not wanted
+    return _cut_covered(env.seg, out, wanted, tol)
+
+
+def _cut_covered(
+    seg: np.ndarray, ring: np.ndarray, wanted: np.ndarray, tol: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """``ring`` with every segment cut where its points come within ``tol`` of a boundary
+    segment (``seg``, (E, 4)) or leave that band; the pieces inside the band are not
+    wanted.  The band around a segment is a capsule, so each (ring segment, boundary
+    segment) pair gives one interval of the ring segment's parameter: the hull of its
+    intersections with the slab and with the two end discs (closed form)."""
+    p0 = ring
+    e = np.roll(ring, -1, axis=0) - ring  # (m, 2)
+    a = seg[None, :, :2]
+    d = seg[None, :, 2:] - a
+    ln = np.maximum(np.hypot(d[..., 0], d[..., 1]), 1e-300)
+    u = d / ln[..., None]  # (1, E, 2)
+    w = p0[:, None, :] - a  # (m, E, 2)
+    ee = e[:, None, :]
+    lo = np.full(w.shape[:2], np.inf)
+    hi = np.full(w.shape[:2], -np.inf)
+    # the slab: |u x (w + s e)| <= tol and 0 <= u . (w + s e) <= |d|
+    s_lo = np.full(w.shape[:2], -np.inf)
+    s_hi = np.full(w.shape[:2], np.inf)
+    for c0, c1, b0, b1 in (
+        (cross(u, w), cross(u, ee), -tol, tol),
+        ((u * w).sum(axis=2), (u * ee).sum(axis=2), 0.0, ln),
+    ):
+        c0, c1 = np.broadcast_arrays(c0, c1)
+        b1 = np.broadcast_to(b1, c0.shape)
+        flat = np.abs(c1) <= 1e-300
+        with np.errstate(divide="ignore", invalid="ignore"):
+            r0 = (b0 - c0) / c1
+            r1 = (b1 - c0) / c1
+        inside = (c0 >= b0) & (c0 <= b1)  # a segment parallel to the band: all or nothing
+        r_lo = np.where(flat, np.where(inside, -np.inf, np.inf), np.minimum(r0, r1))
+        r_hi = np.where(flat, np.where(inside, np.inf, -np.inf), np.maximum(r0, r1))
+        s_lo, s_hi = np.maximum(s_lo, r_lo), np.minimum(s_hi, r_hi)
+    ok = s_lo <= s_hi
+    lo, hi = np.where(ok, s_lo, lo), np.where(ok, s_hi, hi)
+    # the discs at both ends: |w' + s e|^2 <= tol^2
+    e2 = np.maximum((e * e).sum(axis=1), 1e-300)[:, None]
+    for wq in (w, w - d):
+        bq = (wq * ee).sum(axis=2)
+        disc = bq * bq - e2 * ((wq * wq).sum(axis=2) - tol * tol)
+        r = np.sqrt(np.maximum(disc, 0.0))
+        has = disc >= 0
+        lo = np.where(has, np.minimum(lo, (-bq - r) / e2), lo)
+        hi = np.where(has, np.maximum(hi, (-bq + r) / e2), hi)
+    lo, hi = np.clip(lo, 0.0, 1.0), np.clip(hi, 0.0, 1.0)
+    length = np.sqrt(e2[:, 0])
+    hit = (hi - lo) * length[:, None] > tol  # a covered piece longer than tol
+    if not hit.any():
+        return ring, wanted
+    pts, flags = [], []
+    for i in range(len(ring)):
+        js = np.flatnonzero(hit[i])
+        if len(js) == 0:
+            pts.append(ring[i : i + 1])
+            flags.append(wanted[i : i + 1])
+            continue
+        iv = sorted(zip(lo[i, js], hi[i, js], strict=True))
+        merged = [list(iv[0])]
+        for l0, h0 in iv[1:]:
+            if l0 <= merged[-1][1]:
+                merged[-1][1] = max(merged[-1][1], h0)
+            else:
+                merged.append([l0, h0])
+        cuts = np.unique(np.clip(np.asarray(merged).ravel(), 0.0, 1.0))
+        step = tol / length[i]
+        cuts = cuts[(cuts > step) & (cuts < 1.0 - step)]
+        cuts = cuts[np.concatenate([[True], np.diff(cuts) > step])] if len(cuts) else cuts
+        ss = np.concatenate([[0.0], cuts])
+        mids = 0.5 * (ss + np.concatenate([cuts, [1.0]]))
+        covered = np.zeros(len(mids), dtype=bool)
+        for l0, h0 in merged:
+            covered |= (mids >= l0) & (mids <= h0)
+        piece = ring[i] + ss[:, None] * e[i]
+        piece[0] = ring[i]
+        pts.append(piece)
+        flags.append(wanted[i] & ~covered)
+    return np.concatenate(pts), np.concatenate(flags)
+
+
+def _feet(seg: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """For points ``p`` (n, 2) and segments ``seg`` (E, 4): the nearest point of every
+    segment to every point, (n, E, 2), and its distance, (n, E)."""
+    a = seg[:, :2]
+    e = seg[:, 2:] - a
+    ll = np.maximum((e * e).sum(axis=1), 1e-300)
+    d = p[:, None, :] - a[None, :, :]
+    t = np.clip((d * e[None]).sum(axis=2) / ll, 0.0, 1.0)
+    foot = a[None] + t[..., None] * e[None]
+    return foot, np.hypot(*(p[:, None, :] - foot).transpose(2, 0, 1))
 
 
 def _union(polys: list[shapely.Geometry], n_first: int) -> shapely.Geometry:

@@ -15,8 +15,9 @@ without a prior import.  Rewards are exact: they come from
 __version__ = "0.1.0"
 
 from .core.world import BUNDLED_SCENES  # noqa: E402
+from .core.scenes import REAL_SCENES  # noqa: E402
 from .registration import ENV_IDS, register_sensorplan_envs  # noqa: E402
 
 register_sensorplan_envs()
 
-__all__ = ["BUNDLED_SCENES", "ENV_IDS", "__version__", "register_sensorplan_envs"]
+__all__ = ["BUNDLED_SCENES", "ENV_IDS", "REAL_SCENES", "__version__", "register_sensorplan_envs"]

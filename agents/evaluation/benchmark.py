@@ -1,7 +1,8 @@
 """The benchmark protocol: every policy on named scene splits, one table.
 
 ``sensorplan benchmark --env ID --policies oracle random model.zip ... [--episodes N]
-[--difficulty D] [--splits train test ood] [--env-kwargs JSON] [--out DIR]``
+[--difficulty D] [--level easy|medium|hard] [--splits train test ood] [--env-kwargs JSON]
+[--out DIR]``
 
 Splits (each an env-kwargs override on top of ``--env-kwargs``):
 
@@ -16,7 +17,11 @@ Procedural splits of tasks with a start (Navigate, Recognize) draw a start per e
 * ``test`` -- procedural scenes from the disjoint pool of seed :data:`TEST_POOL_SEED`, never
   trained on;
 * ``ood`` -- every bundled scene (``lab``, ``edr``, ``corridor``, ``warehouse``), one split
-  each (``ood:lab`` ...): hand-made maps outside the generator's distribution.
+  each (``ood:lab`` ...): hand-made maps outside the generator's distribution, from a start
+  drawn per episode (``random_start=True``) where the task has one;
+* ``real`` -- every bundled real floor plan (:data:`sensorplan_gym.REAL_SCENES`, public ROS
+  maps of the Willow Garage office and the LSE arena), one split each (``real:willow_north``
+  ...); not in the default splits (give ``--splits train test ood real``).
 
 The difficulty knob ``--difficulty D`` (default :data:`DEFAULT_DIFFICULTY`) is the env kwarg
 ``min_start_distance``: procedural scenes start at least ``D`` scene diameters away from the
@@ -24,6 +29,11 @@ recognizable region (Navigate, Recognize; Placement has no start).  It is report
 result, with the measured mean start distance of the scenes played.  At the default the random
 policy succeeds in about 0.2 of Navigate-v0's test episodes (measured with 64 batched
 envs over 1,000 steps: 0.22 at ``D = 0.35``, 0.83 at ``D = 0``).
+
+The benchmark levels ``--level easy|medium|hard`` (:data:`geometry.families.DIFFICULTIES`)
+draw the procedural splits from the level's scene family (field of view, range, room shapes,
+clutter, G/H kinds, targets) at the level's ``min_start_distance`` (unless ``--difficulty``
+is given); the bundled scenes are played as they are.
 
 Per split and policy: what :func:`agents.evaluation.evaluate.evaluate` reports (success with
 its Wilson interval, return, steps, path length, normalized score; IQM over training seeds).  Writes
@@ -62,9 +72,11 @@ DEFAULT_DIFFICULTY = 0.35
 POOL_KWARGS = {
     "scene_pool_seed": TRAIN_POOL_SEED,
     "scene_pool_size": 64,
-    "min_start_distance": 0.0,
+    "min_start_distance": None,
     "max_scene_tries": 25,
     "random_scene_kwargs": None,
+    "family": None,
+    "difficulty": None,
 }
 
 
@@ -94,41 +106,55 @@ def training_pool(policies: list[str]) -> dict | None:
 
 
 def splits(
-    names: list[str], difficulty: float, needs_start: bool, train_pool: dict | None = None
+    names: list[str],
+    difficulty: float | None,
+    needs_start: bool,
+    train_pool: dict | None = None,
+    level: str | None = None,
 ) -> dict[str, dict]:
     """Env-kwargs overrides of the named splits (``ood`` expands to one split per scene).
     ``train`` is ``train_pool`` (see :func:`training_pool`; its own ``min_start_distance``
     replaces ``difficulty``) when given, else the default pool of seed
-    :data:`TRAIN_POOL_SEED` at ``difficulty``."""
-    from sensorplan_gym import BUNDLED_SCENES
+    :data:`TRAIN_POOL_SEED` at ``difficulty``.  ``level`` (``"easy"``, ``"medium"``,
+    ``"hard"``: :data:`geometry.families.DIFFICULTIES`) draws the procedural splits from that
+    level's scene family, at its ``min_start_distance`` unless ``difficulty`` is given."""
+    from sensorplan_gym import BUNDLED_SCENES, REAL_SCENES
 
-    hard = (
-        {"min_start_distance": difficulty, "max_scene_tries": 200}
-        if needs_start and difficulty > 0
-        else {}
-    )
+    hard: dict = {}
+    if level is not None:
+        hard["difficulty"] = level
+    if needs_start and difficulty is not None and difficulty > 0:
+        hard.update(min_start_distance=difficulty)
+    if needs_start and (level is not None or "min_start_distance" in hard):
+        hard["max_scene_tries"] = 200
     if needs_start:  # a start drawn per episode: 100 episodes are not 64 scene-start pairs
         hard = {"random_start": True, **hard}
+    # bundled and real scenes: a start drawn per episode too (their fixed start is one episode)
+    start = {"random_start": True} if needs_start else {}
     out: dict[str, dict] = {}
     for name in names:
         if name == "train" and train_pool is not None:
             pool = {k: v for k, v in train_pool.items() if v is not None}
             if not needs_start:
                 pool.pop("min_start_distance", None)
-            start = {"random_start": True} if needs_start else {}
             out[name] = {"scene": "random", **start, **pool}
         elif name == "train":
             out[name] = {"scene": "random", "scene_pool_seed": TRAIN_POOL_SEED, **hard}
         elif name == "test":
             out[name] = {"scene": "random", "scene_pool_seed": TEST_POOL_SEED, **hard}
         elif name == "ood":
-            out.update({f"ood:{s}": {"scene": s} for s in BUNDLED_SCENES})
+            out.update({f"ood:{s}": {"scene": s, **start} for s in BUNDLED_SCENES})
+        elif name == "real":
+            out.update({f"real:{s[5:]}": {"scene": s, **start} for s in REAL_SCENES})
         elif name.startswith("ood:") and name[4:] in BUNDLED_SCENES:
-            out[name] = {"scene": name[4:]}
+            out[name] = {"scene": name[4:], **start}
+        elif name.startswith("real:") and f"real/{name[5:]}" in REAL_SCENES:
+            out[name] = {"scene": f"real/{name[5:]}", **start}
         else:
             raise ValueError(
-                f"unknown split {name!r}: use train, test, ood or ood:<scene> "
-                f"({', '.join(BUNDLED_SCENES)})"
+                f"unknown split {name!r}: use train, test, ood, ood:<scene> "
+                f"({', '.join(BUNDLED_SCENES)}), real or real:<map> "
+                f"({', '.join(s[5:] for s in REAL_SCENES)})"
             )
     return out
 
@@ -153,8 +179,9 @@ def benchmark(
     *,
     episodes: int = 100,
     seed: int = 0,
-    difficulty: float = DEFAULT_DIFFICULTY,
+    difficulty: float | None = DEFAULT_DIFFICULTY,
     split_names: list[str] | None = None,
+    level: str | None = None,
     env_kwargs: dict | None = None,
     out: str | Path | None = None,
     verbose: bool = True,
@@ -167,6 +194,12 @@ def benchmark(
     import sensorplan_gym  # noqa: F401
 
     check_policies(policies)  # every path, before any episode is played
+    if level is not None:
+        from geometry.families import get_difficulty
+
+        lv = get_difficulty(level)  # a clear error for an unknown level, before any output
+        if difficulty is None:
+            difficulty = lv.min_start_distance
     out = check_writable_dir(
         out if out is not None else fresh_dir(Path("runs") / f"benchmark_{env_id.split('/')[-1]}")
     )
@@ -176,10 +209,13 @@ def benchmark(
     probe.close()
     names = split_names or ["train", "test", "ood"]
     pool = training_pool(policies) if "train" in names else None
-    sp = splits(names, difficulty, needs_start, train_pool=pool)
+    sp = splits(names, difficulty, needs_start, train_pool=pool, level=level)
     res: dict[str, Any] = {
         "env_id": env_id,
-        "difficulty": {"min_start_distance": difficulty if needs_start else None},
+        "difficulty": {
+            "min_start_distance": difficulty if needs_start else None,
+            "level": level,
+        },
         "episodes": episodes,
         "seed": seed,
         "deterministic": bool(deterministic),

@@ -227,6 +227,7 @@ OBSERVATION_KWARGS = (
     "declare_hold",
     "placement_grid",
     "placement_aims",
+    "self_features",
 )
 
 

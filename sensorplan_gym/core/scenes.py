@@ -2,9 +2,10 @@
 
 :func:`load_scene` takes a bundled scene name, a path to a scene file in any of the
 formats of :mod:`geometry.formats` (scene JSON, GeoJSON, WKT; by extension, and for
-``.json`` by content), a parsed dict (scene JSON or a GeoJSON FeatureCollection) or a
-:class:`geometry.Scene`.  The envs' ``scene=``, ``sensorplan view``, ``sensorplan
-convert`` and the tools that take scene names all call it.
+``.json`` by content) or a ROS occupancy-grid map YAML with the scene's extra keys
+(:func:`geometry.occupancy.scene_from_ros_map`), a parsed dict (scene JSON or a GeoJSON
+FeatureCollection) or a :class:`geometry.Scene`.  The envs' ``scene=``, ``sensorplan view``,
+``sensorplan convert`` and the tools that take scene names all call it.
 """
 
 from __future__ import annotations
@@ -15,15 +16,29 @@ from pathlib import Path
 
 from geometry import Scene
 from geometry.formats import SCENE_SUFFIXES, load_scene_file, scene_from_data
+from geometry.occupancy import ROS_MAP_SUFFIXES, scene_from_ros_map
 
-__all__ = ["BUNDLED_SCENES", "SCENE_DIR", "SCENE_SUFFIXES", "bundled_scene_path", "load_scene"]
+__all__ = [
+    "BUNDLED_SCENES",
+    "REAL_SCENES",
+    "SCENE_DIR",
+    "SCENE_SUFFIXES",
+    "bundled_scene_path",
+    "load_scene",
+]
 
 SCENE_DIR = Path(__file__).resolve().parent.parent / "scenes"
+#: the hand-made bundled scenes
 BUNDLED_SCENES = tuple(sorted(p.stem for p in SCENE_DIR.glob("*.json")))
+#: the bundled real floor plans (public ROS maps, ``scenes/real/provenance.json``), by the
+#: names ``real/<stem>``
+REAL_SCENES = tuple(
+    f"real/{p.stem}" for p in sorted((SCENE_DIR / "real").glob("*.json")) if p.stem != "provenance"
+)
 
 
 def bundled_scene_path(name: str) -> Path:
-    """Path of the bundled scene JSON ``name`` (e.g. ``"lab"``)."""
+    """Path of the bundled scene JSON ``name`` (e.g. ``"lab"`` or ``"real/willow_north"``)."""
     return SCENE_DIR / f"{name}.json"
 
 
@@ -31,7 +46,8 @@ def load_scene(spec: str | PathLike[str] | Scene | Mapping, *, name: str | None 
     """A validated :class:`geometry.Scene` from
 
     * a bundled scene name (:data:`BUNDLED_SCENES`: ``lab``, ``edr``, ``corridor``,
-      ``warehouse``);
+      ``warehouse``; :data:`REAL_SCENES`: ``real/willow_north``, ``real/willow_south``,
+      ``real/lse_arena``);
     * a path to a scene file: ``.json`` (scene JSON, or GeoJSON when the object has a
       ``"type"`` member), ``.geojson`` or ``.wkt`` (see :mod:`geometry.formats`);
     * a dict: scene JSON, or a GeoJSON FeatureCollection (it has a ``"type"`` member);
@@ -49,17 +65,20 @@ def load_scene(spec: str | PathLike[str] | Scene | Mapping, *, name: str | None 
         return scene_from_data(spec, name=name)
     else:
         s = str(spec)
-        if s in BUNDLED_SCENES:
+        if s in BUNDLED_SCENES or s in REAL_SCENES:
             scene = Scene.load(bundled_scene_path(s))
         else:
             p = Path(s)
-            if p.suffix.lower() not in SCENE_SUFFIXES and not p.exists():
+            suffixes = SCENE_SUFFIXES + ROS_MAP_SUFFIXES
+            if p.suffix.lower() not in suffixes and not p.exists():
                 raise ValueError(
                     f"unknown scene {s!r}: use a bundled name ({', '.join(BUNDLED_SCENES)}) "
-                    f"or a path to a scene file ({', '.join(SCENE_SUFFIXES)}); the envs also "
+                    f"or a path to a scene file ({', '.join(suffixes)}); the envs also "
                     "take 'random'"
                 )
             if not p.exists():
                 raise FileNotFoundError(f"scene file not found: {p}")
+            if p.suffix.lower() in ROS_MAP_SUFFIXES:
+                return scene_from_ros_map(p, name=name)
             return load_scene_file(p, name=name)
     return scene if name is None else scene.replace(name=name)

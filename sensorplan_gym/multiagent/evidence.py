@@ -84,11 +84,14 @@ class BeamEvidence:
         self.tol = float(tol)
         self.hits = np.zeros((int(n_watchers), 2), dtype=np.int64)
         self.looks = np.zeros((int(n_watchers), 2), dtype=np.int64)
+        #: the last step counted (the env counts each step once)
+        self.t_counted = -1
 
     def reset(self) -> None:
         """Forget everything (a new episode)."""
         self.hits[:] = 0
         self.looks[:] = 0
+        self.t_counted = -1
 
     def update(
         self,

@@ -136,19 +136,35 @@ def _execute(world: WatchWorld, cfg: MotionConfig, path: np.ndarray, rng) -> np.
     s = np.concatenate([[0.0], np.cumsum(w) / w.sum() * L])
     s[-1] = L
     nominal = _resample(path, s)
-    e = np.zeros(2)
     out = np.empty_like(nominal)
     out[0] = nominal[0]
     emax = cfg.drift * world.diameter
     sigma = 0.25 * emax
-    for t in range(1, T + 1):
-        q = nominal[t]
-        r = min(emax, max(0.0, world.clearance(q[0], q[1]) - world.skin))
-        r *= min(1.0, (T - t) / cfg.settle_steps)
-        e = e + rng.normal(0.0, sigma, 2) if r > 0 else np.zeros(2)
-        n = math.hypot(e[0], e[1])
-        if n > r:
-            e = e * (r / n) if n > 0 else e
-        out[t] = q + e
+    clear = world.clearances(nominal[1:, 0], nominal[1:, 1]).tolist()  # one query for all
+    skin, settle = world.skin, cfg.settle_steps
+    rs = [
+        min(emax, max(0.0, clear[t - 1] - skin)) * min(1.0, (T - t) / settle)
+        for t in range(1, T + 1)
+    ]
+    # the steps with room to drift draw two normals each, in order: drawn at once
+    zl = rng.normal(0.0, sigma, (sum(r > 0 for r in rs), 2)).tolist()
+    drift = []
+    ex = ey = 0.0  # the drift e, in Python floats (the same IEEE operations as on arrays)
+    k = 0
+    for r in rs:
+        if r > 0:
+            ex = ex + zl[k][0]
+            ey = ey + zl[k][1]
+            k += 1
+        else:
+            ex = ey = 0.0
+        n = math.hypot(ex, ey)
+        if n > r and n > 0:
+            f = r / n
+            ex = ex * f
+            ey = ey * f
+        drift.append((ex, ey))
+    drift = np.array(drift)
+    out[1:] = nominal[1:] + drift
     out[T] = nominal[T]
     return out

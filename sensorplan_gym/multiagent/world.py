@@ -31,6 +31,7 @@ from geometry import Scene
 
 from ..core.sensor import Segments
 from ..core.world import boundary_segments, segment_normals
+from . import kernels as _wk
 
 __all__ = ["VisGraph", "WatchConfig", "WatchWorld", "get_watch_world"]
 
@@ -143,6 +144,18 @@ class WatchWorld:
             return 0.0
         return self.cspace_segs.clearance(x, y)
 
+    def clearances(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """:meth:`clearance` of the points ``(x[k], y[k])`` at once (the same numbers)."""
+        from ..core.segments import point_segment_distance
+
+        x = np.ascontiguousarray(x, dtype=np.float64)
+        y = np.ascontiguousarray(y, dtype=np.float64)
+        inside = shapely.contains_xy(self.cspace, x, y)
+        out = np.zeros(len(x))
+        if inside.any():
+            out[inside] = point_segment_distance(x[inside], y[inside], self.cspace_segs)
+        return out
+
     def shortest_path(self, a, b, *, avoid: str | None = None) -> np.ndarray | None:
         """Shortest path of A's reference point from ``a`` to ``b`` inside the margin-shrunk
         C-space -- with ``avoid="G"`` (``"H"``) also outside G (H) grown by the margin, so that
@@ -173,8 +186,12 @@ class WatchWorld:
         g = self.goal_geom if which == "G" else self.failure_geom
         if g.geom_type == "Point":
             return np.array([g.x, g.y])
-        inner = shapely.intersection(g, self.cspace_m)
-        src = inner if inner.area > 1e-9 * g.area else g
+        cache = self.__dict__.setdefault("_end_src", {})
+        src = cache.get(which)
+        if src is None:  # the part of the region inside the margin-shrunk C-space (once)
+            inner = shapely.intersection(g, self.cspace_m)
+            src = cache[which] = inner if inner.area > 1e-9 * g.area else g
+            shapely.prepare(src)
         x0, y0, x1, y1 = src.bounds
         for _ in range(10_000):
             x, y = rng.uniform(x0, x1), rng.uniform(y0, y1)
@@ -275,6 +292,29 @@ class VisGraph:
         self.nodes = nodes
         self.ii, self.jj = i[ok], j[ok]
         self.w = np.hypot(*(nodes[self.ii] - nodes[self.jj]).T)
+        self._edges = _vertex_edges(domain, nodes)
+
+    def _visible(self, ends: np.ndarray) -> np.ndarray:
+        """``(2, n)`` bool: the segment from ``ends[k]`` to every node lies in the domain
+        (``shapely.covers``; with numba decided exactly by :func:`.kernels.visible_from`,
+        shapely answering only the cases it leaves open)."""
+        nodes, n = self.nodes, len(self.nodes)
+        if _wk.visible_from is None or self._edges is None:
+            segs = shapely.linestrings(
+                np.stack([np.repeat(ends, n, axis=0), np.tile(nodes, (2, 1))], axis=1)
+            )
+            return shapely.covers(self.domain, segs).reshape(2, n)
+        E, pin, pout, amb = self._edges
+        out = np.empty((2, n), dtype=np.int64)
+        for k in range(2):
+            _wk.visible_from(float(ends[k, 0]), float(ends[k, 1]), nodes, E, pin, pout, amb,
+                             out[k])  # fmt: skip
+        vis = out == 1
+        ku, nu = np.nonzero(out == _wk.UNSURE)
+        if len(ku):
+            segs = shapely.linestrings(np.stack([ends[ku], nodes[nu]], axis=1))
+            vis[ku, nu] = shapely.covers(self.domain, segs)
+        return vis
 
     def __setstate__(self, st: dict) -> None:
         self.__dict__.update(st)
@@ -286,7 +326,6 @@ class VisGraph:
     def shortest_path(self, a, b) -> np.ndarray | None:
         """Way points ``(N, 2)`` of a shortest path from ``a`` to ``b`` within the domain
         (``None`` if there is none, e.g. an end point outside it)."""
-        from scipy.sparse import coo_matrix
         from scipy.sparse.csgraph import dijkstra
 
         dom, nodes = self.domain, self.nodes
@@ -296,10 +335,7 @@ class VisGraph:
             return np.stack([a, b])
         n = len(nodes)
         ends = np.stack([a, b])
-        segs = shapely.linestrings(
-            np.stack([np.repeat(ends, n, axis=0), np.tile(nodes, (2, 1))], axis=1)
-        )
-        vis = shapely.covers(dom, segs).reshape(2, n)
+        vis = self._visible(ends)
         rows, cols, ws = [self.ii, self.jj], [self.jj, self.ii], [self.w, self.w]
         for k in range(2):
             idx = np.nonzero(vis[k])[0]
@@ -307,9 +343,7 @@ class VisGraph:
             rows += [np.full(len(idx), n + k), idx]
             cols += [idx, np.full(len(idx), n + k)]
             ws += [d, d]
-        M = coo_matrix(
-            (np.concatenate(ws), (np.concatenate(rows), np.concatenate(cols))), shape=(n + 2, n + 2)
-        ).tocsr()
+        M = _canonical_csr(np.concatenate(rows), np.concatenate(cols), np.concatenate(ws), n + 2)
         dist, pred = dijkstra(M, indices=n, return_predecessors=True)
         if not np.isfinite(dist[n + 1]):
             return None
@@ -317,6 +351,56 @@ class VisGraph:
         while path[-1] != n:
             path.append(int(pred[path[-1]]))
         return np.concatenate([nodes, ends])[path[::-1]]
+
+
+def _canonical_csr(rows: np.ndarray, cols: np.ndarray, data: np.ndarray, n: int):
+    """The ``n x n`` CSR matrix of the (distinct) entries ``(rows, cols, data)`` in canonical
+    form -- column indices sorted within each row --, the matrix
+    ``coo_matrix(...).tocsr()`` gives, built without its checks."""
+    from scipy.sparse import csr_matrix
+
+    order = np.lexsort((cols, rows))
+    indptr = np.zeros(n + 1, dtype=np.int32)
+    np.cumsum(np.bincount(rows, minlength=n), out=indptr[1:])
+    M = csr_matrix((data[order], cols[order].astype(np.int32), indptr), shape=(n, n))
+    M.has_sorted_indices = True
+    return M
+
+
+def _vertex_edges(domain: shapely.Geometry, nodes: np.ndarray):
+    """The domain's boundary edges ``(4, M)`` (start x, y, end x, y; exteriors
+    counter-clockwise, holes clockwise: the interior on every edge's left) and, per node, its
+    incoming and outgoing edge and whether it is not a simple vertex (it occurs more than
+    once on the boundary); ``None`` when a node is not found on the oriented boundary."""
+    rings = []
+    for poly in shapely.get_parts(shapely.orient_polygons(domain)):
+        if poly.is_empty:
+            continue
+        rings.append(np.asarray(poly.exterior.coords)[:-1])
+        rings.extend(np.asarray(r.coords)[:-1] for r in poly.interiors)
+    index = {(float(x), float(y)): k for k, (x, y) in enumerate(nodes)}
+    n = len(nodes)
+    pin = np.full(n, -1, dtype=np.int64)
+    pout = np.full(n, -1, dtype=np.int64)
+    amb = np.zeros(n, dtype=np.bool_)
+    E = []
+    for ring in rings:
+        m0 = len(E)
+        L = len(ring)
+        for j in range(L):
+            p, q = ring[j], ring[(j + 1) % L]
+            E.append((p[0], p[1], q[0], q[1]))
+            kp = index.get((float(p[0]), float(p[1])))
+            kq = index.get((float(q[0]), float(q[1])))
+            if kp is None or kq is None:
+                return None
+            if pout[kp] >= 0:
+                amb[kp] = True
+            pout[kp] = m0 + j
+            pin[kq] = m0 + j
+    if (pin < 0).any() or (pout < 0).any():
+        return None
+    return np.ascontiguousarray(np.array(E, dtype=np.float64).T), pin, pout, amb
 
 
 def _sum_convex_all(scene: Scene, negK: np.ndarray) -> shapely.Geometry:

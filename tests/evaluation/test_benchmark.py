@@ -77,8 +77,10 @@ def test_procedural_splits_draw_a_start_per_episode_and_count_distinct_episodes(
     test, corridor = res["rows"]
     # 4 pool scenes, 8 episodes: every episode has its own start
     assert test["distinct_episodes"] == 8
-    # the bundled scene keeps its start: one distinct episode, however many are played
-    assert corridor["distinct_episodes"] == 1
+    # bundled scenes too: a start per episode, not the scene's one fixed start
+    assert corridor["distinct_episodes"] == 8
+    assert splits(["ood:lab"], 0.3, needs_start=True)["ood:lab"]["random_start"] is True
+    assert "random_start" not in splits(["ood"], 0.3, needs_start=False)["ood:lab"]
 
 
 def test_wilson_interval_is_sized_by_distinct_episodes():
@@ -133,3 +135,29 @@ def test_train_split_is_the_training_pool():
     if training_pool([nav]) != pool:
         with pytest.raises(ValueError, match="different scene pools"):
             training_pool([rec, nav])
+
+
+def test_level_draws_the_procedural_splits_from_its_family(tmp_path):
+    from geometry.families import get_difficulty
+
+    sp = splits(["train", "test", "ood:lab"], None, needs_start=True, level="hard")
+    assert sp["test"]["difficulty"] == sp["train"]["difficulty"] == "hard"
+    assert "difficulty" not in sp["ood:lab"]  # bundled scenes are what they are
+    # an explicit knob wins over the level's own start distance
+    assert splits(["test"], 0.5, True, level="hard")["test"]["min_start_distance"] == 0.5
+    env = gym.make("sensorplan/Navigate-v0", scene_pool_size=2, **sp["test"])
+    _, info = env.reset(seed=0)
+    d = info["distance_to_region"] / env.unwrapped.world.diameter
+    assert d >= get_difficulty("hard").min_start_distance
+    env.close()
+    with pytest.raises(ValueError, match="unknown difficulty 'nightmare'"):
+        benchmark(
+            "sensorplan/Navigate-v0",
+            ["random"],
+            episodes=1,
+            level="nightmare",
+            split_names=["test"],
+            out=tmp_path / "never",
+            verbose=False,
+        )
+    assert not (tmp_path / "never").exists()
