@@ -4,7 +4,6 @@ does not -- and the saved policy acts as the trained one."""
 
 from __future__ import annotations
 
-import time
 
 import numpy as np
 import pytest
@@ -45,7 +44,6 @@ class _Untrained:
 
 
 def test_tiny_dagger_learns_to_declare(tmp_path):
-    t0 = time.process_time()
     rec = train_watch_imitation(TINY, seed=0, out=tmp_path, verbose=False)
     assert [h["beta"] for h in rec["imitation"]] == [1.0, 0.5, 0.25, 0.125]
     pol = WatchImitationPolicy(tmp_path / "final_model.pt")
@@ -57,7 +55,6 @@ def test_tiny_dagger_learns_to_declare(tmp_path):
     assert right >= 0.85, (right, rec["imitation"])
     assert base < 0.85, base  # the test can fail: an untrained policy does not declare right
     assert np.mean(learned["visible"]) > 0.6, learned["visible"]
-    assert time.process_time() - t0 < 60
 
 
 def test_saved_policy_acts_as_trained_and_collect_checks(tmp_path):
