@@ -82,6 +82,9 @@ def partial_region(
         translates through this region at orientation ``theta`` and the answer is
         the placements that see some point of it *wherever* it is there (the
         complement of the swept shadows, paper 3.2.2-3.2.3, :mod:`geometry.sweep`).
+        A target that is not star-shaped sweeps as its convex hull, which gives the
+        exact region here (:mod:`geometry.nonstar`; with ``eps_aim > 0`` the hull's
+        visibility polygons are the ones dropped).
     theta : orientation (radians) of a target given by ``target_in``; ``None``
         (any orientation) is not supported in the partial model.
     eps_pos : worst-case placement error (scene units): shadows grown by the disc.
