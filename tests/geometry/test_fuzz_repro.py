@@ -39,10 +39,8 @@ OPEN: dict[str, str] = {
     "fuzz-disagree-P_swept-lib_in_truth_out": "26.3 swept partial unsafe",
     "fuzz-disagree-R_part-lib_out_truth_in": "26.2 target under an opening",
     "fuzz-inclusion-complete__partial": "26.5 complete not inside partial",
-    "fuzz-inclusion-recognizable_partial__partial_G_": "26.4 recognizable not inside R(G)",
     "fuzz-inclusion-swept_partial__stationary_partial_aux_": "26.3 swept not inside stationary",
     "fuzz-variance-P_stat": "26.9 frame variance",
-    "recognizable_not_in_RG": "25.7 recognizable not inside R(G)",
     "recognizable_moves_with_frame": "25.7 recognizable moves with the frame",
 }
 
