@@ -37,6 +37,8 @@ is seen.  So the returned region is contained in the exact one (up to the sweep'
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 import shapely
 
@@ -47,6 +49,7 @@ from .sweep import star_center
 __all__ = ["HullTarget", "hull_target", "is_star_shaped", "pocket_area"]
 
 
+@dataclass(frozen=True)
 class HullTarget:
     """The convex-hull stand-in of a non-star-shaped target (see the module docstring).
 
@@ -60,12 +63,9 @@ class HullTarget:
         outline wanted); False when it is a certified inner region.
     """
 
-    def __init__(
-        self, ring: np.ndarray, strips: list[shapely.Geometry] | None, exact: bool
-    ) -> None:
-        self.ring = ring
-        self.strips = strips
-        self.exact = exact
+    ring: np.ndarray
+    strips: list[shapely.Geometry] | None
+    exact: bool
 
 
 def is_star_shaped(ring: np.ndarray) -> bool:
