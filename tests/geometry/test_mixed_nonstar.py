@@ -201,7 +201,7 @@ def test_mixed_recognizable_against_brute_force(seed, goal, failure, target):
         [shapely.affinity.translate(sc.target_at(0, 0, theta), *q) for q in cg]
         + [shapely.affinity.translate(sc.target_at(0, 0, theta), pt.x, pt.y)]
     )
-    pts = _placements(sc, rng, 160, shapely.convex_hull(swept) if not star else swept)
+    pts = _placements(sc, rng, 120, shapely.convex_hull(swept) if not star else swept)
     truth_pt = Truth(sc, theta, [np.array([pt.x, pt.y])], poly)
     truth_poly = Truth(sc, theta, cg, pt)
     good_pt = np.array([truth_pt.sees_all(p) for p in pts])
@@ -252,7 +252,7 @@ def test_mixed_confusion_against_brute_force(swap):
     )
     lost = plain.difference(region)
     assert lost.area > 0.02 * plain.area  # the cuts matter here
-    cg = _configs(poly, rng, per_edge=6, inner=6)
+    cg = _configs(poly, rng, per_edge=4, inner=4)
     avoid = shapely.union_all(
         [shapely.affinity.translate(sc.target_at(0, 0, 0), *q) for q in np.vstack([cg, [[0, 0]]])]
     )
@@ -368,7 +368,7 @@ def test_nonstar_with_strips_is_certified(seed, goal, failure):
     avoid = shapely.union_all(
         [shapely.affinity.translate(sc.target_at(0, 0, 0), *q) for qs, _ in configs for q in qs]
     )
-    pts = _placements(sc, rng, 120, avoid)
+    pts = _placements(sc, rng, 90, avoid)
     good = np.ones(len(pts), bool)
     for qs, other in configs:
         tr = Truth(sc, 0.0, qs, other)
