@@ -95,7 +95,8 @@ class SceneFamily:
     clutter : ``(low, high)`` obstacle area as a fraction of the room's area.
     region_kinds : kinds of G and H (``"point"``, ``"polygon"``), drawn uniformly.
     mixed_regions : draw G's and H's kinds independently; ``False`` (default): one kind for
-        both (the partial model does not support a point G with a polygonal H yet, issue 25).
+        both (the default keeps the families' draws as they were; the partial model answers
+        mixed kinds since issue 25, :mod:`geometry.mixed`).
     target_convex : allowed target convexities (``True``: convex, ``False``: not).
     target_vertices : ``(low, high)`` inclusive vertex count of the target.
     diameter : ``(low, high)`` scene diameter (bounding-box diagonal, scene units).

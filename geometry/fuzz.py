@@ -40,7 +40,11 @@ demands equality up to the output's rounding.
 near-duplicate target vertices, flush obstacles over both ends of a target edge, a target
 under an opening, a second obstacle sharing a flush one's edge.
 
-``python -m geometry.fuzz --n 10000 [--swept] [--contacts] [--frames] [--seed 0]`` runs the
+``nonstar=True`` (``--nonstar``) draws targets with an empty kernel (U, comb, hook), and
+with ``swept`` scenes that mix a point and a polygon also run the mixed recognizable
+region (``⊆`` the partial regions of both; issue 25).
+
+``python -m geometry.fuzz --n 10000 [--swept] [--contacts] [--frames] [--nonstar]`` runs the
 long version and prints a table; ``tests/geometry/test_fuzz.py`` runs a fast one in the
 default test run.
 """
@@ -228,6 +232,35 @@ def _target(rng: np.random.Generator, r: float) -> np.ndarray:
     return _star(rng, int(rng.integers(5, 12)), 0.4 * r, r)  # star-shaped, non-convex
 
 
+def _nonstar(rng: np.random.Generator, r: float) -> np.ndarray:
+    """A target with an empty kernel (radius about ``r``, counter-clockwise, centred):
+    a U, a comb with 2-4 teeth or a hook, at a random orientation."""
+    kind = int(rng.integers(3))
+    depth = rng.uniform(0.5, 0.9)
+    if kind == 0:  # U
+        w = rng.uniform(0.2, 0.6)
+        t = [[-1, -1], [1, -1], [1, 1], [w, 1], [w, 1 - 2 * depth], [-w, 1 - 2 * depth],
+             [-w, 1], [-1, 1]]  # fmt: skip
+    elif kind == 1:  # comb: teeth up from a base
+        n = int(rng.integers(2, 5))
+        xs = np.linspace(-1.0, 1.0, 2 * n)
+        t = [[-1.0, -1.0], [1.0, -1.0]]  # then right to left: tooth k spans xs[2k..2k+1]
+        for k in range(n - 1, -1, -1):
+            x0, x1 = xs[2 * k], xs[2 * k + 1]
+            t += [[x1, 1.0], [x0, 1.0]]
+            if k > 0:
+                t += [[x0, 1 - 2 * depth], [xs[2 * k - 1], 1 - 2 * depth]]
+    else:  # hook: a slot cut in from the right
+        h = rng.uniform(0.1, 0.4)
+        y = rng.uniform(-0.4, 0.4)
+        t = [[-1, -1], [1, -1], [1, y - h], [1 - 2 * depth, y - h], [1 - 2 * depth, y + h],
+             [1, y + h], [1, 1], [-1, 1]]  # fmt: skip
+    a = rng.uniform(0, 2 * math.pi)
+    rot = np.array([[math.cos(a), math.sin(a)], [-math.sin(a), math.cos(a)]])
+    out = np.asarray(t, dtype=float) @ rot * (r / math.sqrt(2.0))
+    return out - np.asarray(shapely.Polygon(out).centroid.coords[0])
+
+
 def _place(rng: np.random.Generator, free: shapely.Geometry, clear: float) -> np.ndarray | None:
     inner = free.buffer(-clear)
     if inner.is_empty:
@@ -258,16 +291,21 @@ def _snap(v: Any, grid: float) -> Any:
     return float(np.round(v / grid) * grid)
 
 
-def fuzz_scene(seed: int, *, max_edges: int = 60, contacts: bool = False) -> dict[str, Any] | None:
+def fuzz_scene(
+    seed: int, *, max_edges: int = 60, contacts: bool = False, nonstar: bool = False
+) -> dict[str, Any] | None:
     """A random degenerate scene dictionary (or ``None`` when the draw failed to give a
     valid scene after a few tries).  ``"features"`` (not a scene key; removed before
     use) lists the degeneracies drawn.  ``contacts=True`` adds the families issue 26
     found the generator blind to: near-duplicate target vertices (1e-9 of the target
     apart), flush obstacles covering both ends of a target edge, a target flush under an
-    opening between two obstacles, and a second obstacle sharing the flush one's edge."""
+    opening between two obstacles, and a second obstacle sharing the flush one's edge.
+    ``nonstar=True`` (issue 25) makes 60 % of the targets non-star-shaped (a U, a comb
+    or a hook; feature ``"nonstar"``).  Either flag leaves the draws of the other
+    scenes as they were: ``fuzz_scene(s) == fuzz_scene(s, nonstar=False)``."""
     rng = np.random.default_rng(seed)
     for _ in range(8):
-        d = _draft_scene(rng, max_edges, contacts)
+        d = _draft_scene(rng, max_edges, contacts, nonstar)
         if d is None:
             continue
         try:
@@ -279,7 +317,7 @@ def fuzz_scene(seed: int, *, max_edges: int = 60, contacts: bool = False) -> dic
 
 
 def _draft_scene(
-    rng: np.random.Generator, max_edges: int, contacts: bool = False
+    rng: np.random.Generator, max_edges: int, contacts: bool = False, nonstar: bool = False
 ) -> dict[str, Any] | None:
     dr = _Draft(_bounds(rng))
     diam = float(np.hypot(*np.ptp(dr.bounds, axis=0)))
@@ -294,6 +332,9 @@ def _draft_scene(
     free = bpoly.difference(shapely.union_all(obs)) if obs else bpoly
     r = diam * rng.uniform(0.01, 0.05)
     target = _target(rng, r)
+    if nonstar and rng.random() < 0.6:
+        target = _nonstar(rng, r)
+        dr.features.append("nonstar")
     if rng.random() < 0.2:  # reference point on the outline or outside the target
         if rng.random() < 0.5:
             target = target - target[int(rng.integers(len(target)))]
@@ -554,6 +595,7 @@ def check_scene(
     q0 = (float(s.goal[0, 0]), float(s.goal[0, 1]), 0.0)
     point_gh = len(s.goal) == 1 and len(s.failure) == 1
     poly_gh = len(s.goal) > 1 and len(s.failure) > 1
+    mixed_gh = not point_gh and not poly_gh
 
     def run(name: str, fn: Callable[[], Any]) -> Any:
         r = _timed(fn, name, out, times, hang_s)
@@ -639,6 +681,28 @@ def check_scene(
             )
             incl(r52, p_g, "recognizable 5.2 ⊆ R(G)")
             incl(r52, p_h, "recognizable 5.2 ⊆ R(H)")
+        if mixed_gh:  # one point, one polygon (issue 25)
+            rmx = run(
+                "recognizable partial mixed",
+                lambda: recognizable_region(s, model="partial", theta=theta, conservative=True),
+            )
+            for w, reg in (("G", s.goal), ("H", s.failure)):
+                which = "goal" if w == "G" else "failure"
+                if len(reg) == 1:
+                    rw = _timed(
+                        lambda reg=reg: partial_region(s, target_at=(*reg[0], theta)),
+                        f"partial at {w}",
+                        out,
+                        {},
+                    )
+                else:
+                    rw = _timed(
+                        lambda which=which: partial_region(s, target_in=which, theta=theta),
+                        f"partial in {w}",
+                        out,
+                        {},
+                    )
+                incl(rmx, rw, f"recognizable mixed ⊆ R({w})")
             if frames and r52 is not None and theta == 0.0:
                 # ... and it is recognizable for every pose pair: G and H shrunk to one
                 # vertex each gives the stationary recognizable region (issue 25 item 3)
@@ -760,6 +824,7 @@ def run_many(
     verbose: bool = False,
     contacts: bool = False,
     frames: bool = False,
+    nonstar: bool = False,
 ) -> dict[str, Any]:
     """Fuzz ``n`` scenes (seeds ``seed .. seed + n - 1``); returns a summary dictionary."""
     kinds: Counter[str] = Counter()
@@ -768,7 +833,7 @@ def run_many(
     n_valid = 0
     t0 = time.perf_counter()
     for i in range(seed, seed + n):
-        d = fuzz_scene(i, max_edges=max_edges, contacts=contacts)
+        d = fuzz_scene(i, max_edges=max_edges, contacts=contacts, nonstar=nonstar)
         if d is None:
             continue
         n_valid += 1
@@ -807,6 +872,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument(
         "--frames", action="store_true", help="also scaled (1e-3, 1e3) and UTM frames (issue 26)"
     )
+    ap.add_argument(
+        "--nonstar", action="store_true", help="non-star-shaped targets (U, comb, hook; issue 25)"
+    )
     ap.add_argument("--json", help="write the summary (with failing seeds) to this file")
     ap.add_argument("-v", "--verbose", action="store_true")
     a = ap.parse_args(argv)
@@ -818,6 +886,7 @@ def main(argv: list[str] | None = None) -> int:
         verbose=a.verbose,
         contacts=a.contacts,
         frames=a.frames,
+        nonstar=a.nonstar,
     )
     if a.json:
         with open(a.json, "w", encoding="utf-8") as f:

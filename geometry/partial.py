@@ -43,6 +43,7 @@ from ._common import (
 )
 from ._frame import world_messages
 from ._shapes import ccw_ring, disc_sum, snapped
+from .nonstar import hull_target, is_star_shaped, pocket_area
 from .sweep import swept_shadows
 from .weak import ENV, UNWANTED, WANTED, weak_visibility  # noqa: F401 (re-exported)
 
@@ -81,6 +82,9 @@ def partial_region(
         translates through this region at orientation ``theta`` and the answer is
         the placements that see some point of it *wherever* it is there (the
         complement of the swept shadows, paper 3.2.2-3.2.3, :mod:`geometry.sweep`).
+        A target that is not star-shaped sweeps as its convex hull, which gives the
+        exact region here (:mod:`geometry.nonstar`; with ``eps_aim > 0`` the hull's
+        visibility polygons are the ones dropped).
     theta : orientation (radians) of a target given by ``target_in``; ``None``
         (any orientation) is not supported in the partial model.
     eps_pos : worst-case placement error (scene units): shadows grown by the disc.
@@ -194,6 +198,11 @@ def _swept_region(
     spec = target_spec(scene, None, target_in, float(theta))
     region = scene.region(target_in) if isinstance(target_in, str) else target_in
     target = _ccw_ring(scene.target_at(0.0, 0.0, float(theta)))
+    # a target that is not star-shaped sweeps as its convex hull (geometry/nonstar.py):
+    # exact for the whole outline, a certified inner region with strips (5.2)
+    stand_in = None if is_star_shaped(target) else hull_target(target, strips, region)
+    if stand_in is not None:
+        target, strips = stand_in.ring, stand_in.strips
     shadows, stats = swept_shadows(
         scene_domain(scene),
         scene.free_space,
@@ -211,6 +220,9 @@ def _swept_region(
         shadows = disc_sum(shadows, tol + stats["grid"])
     # floating overlay: the shadows are already snap-rounded on the sweep's own grid
     allowed = shapely.difference(scene.free_space, spec.area)
+    if stand_in is not None and not stand_in.exact:
+        # the pockets swept through the region are dropped like shadows (eps_pos too)
+        shadows = shapely.union(shadows, pocket_area(target, region))
     out = polygonal(shapely.difference(allowed, shadows))
     if eps_pos > 0:
         out = shrink_for_position(out, allowed, eps_pos)

@@ -16,6 +16,8 @@ and from which those two outcomes cannot be confused.
   removed from the target; what is left is one-sided (the target still occludes)
   and the partial-visibility region of the rest is computed for A in G and for
   A in H and intersected.
+* Partial model, polygonal G and H (5.2): the same with strips swept through the
+  regions; one point and one polygon: :mod:`geometry.mixed`.
 """
 
 from __future__ import annotations
@@ -44,6 +46,7 @@ from ._common import (
 from ._frame import world_messages
 from ._shapes import ccw_ring, snapped, union_all
 from .complete import complete_region
+from .mixed import mixed_recognizable
 from .partial import ROTATING_PARTIAL, _swept_region, swept_tol
 from .weak import weak_visibility
 
@@ -79,14 +82,19 @@ def recognizable_region(
         change *where* to stand; the aim itself is checked against the field of
         view by the caller.
 
-    timeout, progress : partial model with polygonal G and H (paper 5.2) only: a time
-        limit in seconds (:class:`~geometry.sweep.QueryTimeout` past it, naming what
-        was left) and a ``progress(done, total)`` callback after every swept edge of
-        G and then of H (see :func:`partial_region`).
-    tol, conservative : partial model with polygonal G and H (paper 5.2) only:
-        the polyline tolerance of the swept shadows (default 1e-4 of the scene
-        diameter) and whether to grow the shadows by it so that the answer lies
-        inside the exact region (see :func:`partial_region`).
+    timeout, progress : partial model with a polygonal G or H (paper 5.2, or one point and
+        one polygon) only: a time limit in seconds (:class:`~geometry.sweep.QueryTimeout`
+        past it, naming what was left) and a ``progress(done, total)`` callback after
+        every swept edge of G and then of H (of the polygonal one when the other is a
+        point; see :func:`partial_region`).
+    tol, conservative : partial model with a polygonal G or H only: the polyline
+        tolerance of the swept shadows (default 1e-4 of the scene diameter) and whether
+        to grow the shadows by it so that the answer lies inside the exact region (see
+        :func:`partial_region`).  With one point and one polygon
+        (:mod:`geometry.mixed`) the point's side is stationary and exact.  A target
+        that is not star-shaped sweeps as its convex hull (:mod:`geometry.nonstar`):
+        with the overlap strips of this query that gives a certified region *inside*
+        the exact one (the pockets swept through G and H are dropped).
 
     Returns
     -------
@@ -138,11 +146,14 @@ def _recognizable_region(
         raise NotImplementedError(ROTATING_PARTIAL)
     g, h = scene.goal_geom, scene.failure_geom
     th = float(theta)
-    if g.geom_type != h.geom_type:
-        raise NotImplementedError(
-            "recognizable_region(model='partial') needs G and H of the same kind: both points "
-            "(paper 5.1) or both polygons (paper 5.2); this scene mixes a point and a polygon"
-        )
+    if g.geom_type != h.geom_type:  # one point, one polygon: geometry/mixed.py
+        poly = g if g.geom_type == "Polygon" else h
+        target = ccw_ring(scene.target_at(0.0, 0.0, th))
+        acc = _accuracy(scene)
+        return mixed_recognizable(
+            scene, th, eps_pos, eps_aim, swept_tol(scene, tol), conservative,
+            budget or Budget(), overlap_strips(target, poly, *acc), *acc,
+        )  # fmt: skip
     if g.geom_type == "Polygon":
         return _swept_recognizable(
             scene, th, eps_pos, eps_aim, swept_tol(scene, tol), conservative, budget or Budget()

@@ -26,9 +26,9 @@ Target motion (``motion``)
 With ``model="partial"`` and polygonal G/H the region is the paper's 5.2
 construction (swept shadows of the non-confusable part of the target, built
 once per scene and configuration: about 1 s on a bundled scene).  Combinations
-the geometry does not support (``"rotating"`` with the partial model, or a point
-G with a polygonal H in the partial model) raise ``NotImplementedError``
-carrying the geometry's message.
+the geometry does not support (``"rotating"`` with the partial model) raise
+``NotImplementedError`` carrying the geometry's message; a point G with a
+polygonal H (or the reverse) is supported (``geometry.mixed``).
 """
 
 from __future__ import annotations

@@ -36,9 +36,7 @@ AREA_TOL_REL = 1e-7
 #: Cases not fixed yet: strict xfail, with the reason.
 OPEN: dict[str, str] = {
     "fuzz-disagree-P_swept-lib_in_truth_out": "26.3 swept partial unsafe",
-    "fuzz-inclusion-recognizable_partial__partial_G_": "26.4 recognizable not inside R(G)",
     "fuzz-inclusion-swept_partial__stationary_partial_aux_": "26.3 swept not inside stationary",
-    "recognizable_not_in_RG": "25.7 recognizable not inside R(G)",
     "recognizable_moves_with_frame": "25.7 recognizable moves with the frame",
 }
 

@@ -303,10 +303,10 @@ def test_swept_bad_input_is_named():
         partial_region(sc, target_in="goal", tol=-1.0)
     with pytest.raises(ValueError, match="tol"):
         recognizable_region(sc, model="partial", tol=float("nan"))
-    with pytest.raises(NotImplementedError, match="same kind"):
-        g = sc.goal_geom.representative_point()
-        recognizable_region(sc.replace(goal=[[g.x, g.y]]), model="partial")
-    # a target with an empty kernel (a zig-zag) is refused with the reason
+    # one point and one polygon is answered (issue 25; tests/geometry/test_mixed_nonstar.py)
+    g = sc.goal_geom.representative_point()
+    assert recognizable_region(sc.replace(goal=[[g.x, g.y]]), model="partial").is_valid
+    # a target with an empty kernel (a zig-zag) sweeps as its hull (geometry/nonstar.py)
     from geometry.sweep import star_center
 
     hooks = np.array(
