@@ -483,6 +483,12 @@ class Sweeper:
         if not float(np.hypot(*dq)) > 0:
             return [frames[0.0][0]], stats
         ts = self._refine_births(ts, q0, dq, frame, stats)
+        # one sample between consecutive collinearity events (shadows born on a line)
+        ev = np.concatenate([[0.0], self._events(q0, dq), [1.0]])
+        mids = {float(t) for t in 0.5 * (ev[1:] + ev[:-1])}
+        ts = sorted(set(ts) | mids)
+        for t in ts:
+            frame(t)
         pieces = [frames[t][0] for t in ts]
         cover: dict[tuple, list] = {}
         # (t, key): an edge on that line at sample t is confirmed by the exact point test
@@ -516,6 +522,132 @@ class Sweeper:
                 pieces.append(frames[gap][0])
                 todo += [(a, gap, depth + 1), (gap, b, depth + 1)]
         return pieces, stats
+
+    def _events(self, q0: np.ndarray, dq: np.ndarray) -> np.ndarray:
+        """Times in (0, 1), sorted, at which the target moving along ``q0 + t dq`` meets
+        a *collinearity event*: a moving anchor (target vertex or end of a wanted piece)
+        crosses the line through two convex obstacle corners whose joining line is
+        tangent at both, or through an obstacle edge; or the line through two target
+        vertices crosses a convex obstacle corner.  Only events whose line is
+        unobstructed between its anchors count.
+
+        At such an event two shadow-edge lines coincide, and a shadow can be born as a
+        segment on that line (it then grows from a line that continues an edge of an
+        existing shadow, so the eroded-target test of :meth:`_refine_births`, which
+        looks for shadow components apart from the known ones, does not see it: fuzz
+        issue 26.3/26.4).  Sampling once between consecutive events catches such a
+        shadow at a time it has area, and its edges are then traced both ways."""
+        b, i, j = self._corners_and_tangents()
+        env = self.env
+        # obstacle edges with a convex end (a beam can graze along them past that end)
+        cvx = np.flatnonzero(env.reflex)
+        p0 = np.vstack([b[i], env.vert[cvx], env.vert[cvx]])
+        p1 = np.vstack([b[j], env.vert_next[cvx], env.vert_prev[cvx]])
+        w = p1 - p0
+        # moving anchors at t = 0 and their velocities (target vertices: dq; ends of the
+        # wanted pieces slide along their strip segment)
+        q0v = q0[None, :]
+        mov0 = [self.ring0 + q0v]
+        vel = [np.broadcast_to(dq, self.ring0.shape)]
+        if len(self._cut_segs):
+            ids = self.n_fixed + self.m + np.arange(len(self._cut_segs))
+            with np.errstate(invalid="ignore"):  # an edge parallel to its strip segment
+                c0 = self.pos(ids, np.repeat(q0v, len(ids), 0))
+                c1 = self.pos(ids, np.repeat((q0 + dq)[None, :], len(ids), 0))
+            ok = np.isfinite(c0).all(axis=1) & np.isfinite(c1).all(axis=1)
+            mov0.append(c0[ok])
+            vel.append(c1[ok] - c0[ok])
+        x0, vx = np.vstack(mov0), np.vstack(vel)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            # x0 + t vx on the line (p0, w)
+            ta = _cross(w[:, None, :], p0[:, None, :] - x0[None]) / _cross(
+                w[:, None, :], vx[None]
+            )
+            ii, kk = np.triu_indices(self.m, 1)
+            wt = self.ring0[kk] - self.ring0[ii]
+            a0 = self.ring0 + q0v
+            tb = _cross(wt[None], b[:, None, :] - a0[ii][None]) / _cross(wt, dq)[None]
+        lo, hi = 1e-9, 1 - 1e-9
+        la, xa = np.nonzero(np.isfinite(ta) & (ta > lo) & (ta < hi))
+        ta = ta[la, xa]
+        lb, pb = np.nonzero(np.isfinite(tb) & (tb > lo) & (tb < hi))
+        tb = tb[lb, pb]
+        # unobstructed: the line's piece spanning its three points lies in the free space
+        xs = x0[xa] + ta[:, None] * vx[xa]
+        pts = np.stack([p0[la], p1[la], xs], axis=1)  # (A, 3, 2)
+        u = w[la] / np.maximum(np.hypot(w[la, 0], w[la, 1]), 1e-300)[:, None]
+        s_ = np.einsum("akj,aj->ak", pts - pts[:, :1], u)
+        seg_a = np.stack(
+            [
+                pts[np.arange(len(pts)), np.argmin(s_, axis=1)],
+                pts[np.arange(len(pts)), np.argmax(s_, axis=1)],
+            ],
+            axis=1,
+        )
+        ai = a0[ii[pb]] + tb[:, None] * dq
+        ak = a0[kk[pb]] + tb[:, None] * dq
+        bb = b[lb]
+        near = np.where(
+            (np.hypot(*(ai - bb).T) <= np.hypot(*(ak - bb).T))[:, None], ai, ak
+        )
+        seg_b = np.stack([bb, near], axis=1)
+        segs = np.concatenate([seg_a, seg_b])
+        t = np.concatenate([ta, tb])
+        if len(t) == 0:
+            return t
+        keep = self._tangent_events(xa, ta, la, w, lb, pb, b, ii, kk)
+        keep &= shapely.covers(self._free_near(), shapely.linestrings(segs))
+        cut = np.flatnonzero(xa >= self.m)  # ends of wanted pieces: on their edge then?
+        if len(cut):
+            k = xa[cut] - self.m
+            kk_ = np.flatnonzero(np.isfinite(c0).all(axis=1) & np.isfinite(c1).all(axis=1))[k]
+            i_e = self._cut_edge[kk_]
+            a_e = self.ring0[i_e] + q0 + ta[cut, None] * dq
+            e_e = self.edge0[i_e]
+            s_e = self._cut_segs[kk_]
+            x_e = xs[cut]
+            u_e = np.einsum("ij,ij->i", x_e - a_e, e_e) / np.einsum("ij,ij->i", e_e, e_e)
+            d_s = s_e[:, 2:] - s_e[:, :2]
+            w_e = np.einsum("ij,ij->i", x_e - s_e[:, :2], d_s) / np.maximum(
+                np.einsum("ij,ij->i", d_s, d_s), 1e-300
+            )
+            keep[cut] &= (u_e >= -1e-9) & (u_e <= 1 + 1e-9) & (w_e >= -1e-9) & (w_e <= 1 + 1e-9)
+        t = np.unique(t[keep])
+        if len(t) > 1:  # merge events closer than the tracing can tell apart
+            t = t[np.concatenate([[True], np.diff(t) > 1e-9])]
+        return t
+
+    def _tangent_events(self, xa, ta, la, w, lb, pb, b, ii, kk) -> np.ndarray:
+        """Which events can bound a shadow: the moving vertex's line is tangent to the
+        target there (both ring neighbours on one side), the line through two target
+        vertices has the whole target on one side and grazes the obstacle at ``b``."""
+        m = self.m
+        eps = 1e-12 * self.env.scale**2
+        keep_a = np.ones(len(ta), dtype=bool)
+        tv = xa < m
+        if tv.any():
+            k = xa[tv]
+            wl = w[la[tv]]
+            sp = _cross(wl, self.ring0[(k - 1) % m] - self.ring0[k])
+            sn = _cross(wl, self.ring0[(k + 1) % m] - self.ring0[k])
+            keep_a[tv] = ~((sp > eps) & (sn < -eps) | (sp < -eps) & (sn > eps))
+        wt = self.ring0[kk[pb]] - self.ring0[ii[pb]]
+        side = _cross(wt[:, None, :], self.ring0[None, :, :] - self.ring0[ii[pb]][:, None, :])
+        one_side = ~((side > eps).any(axis=1) & (side < -eps).any(axis=1))
+        env = self.env
+        bp = env.vert_prev[env.reflex][lb] - b[lb]
+        bn = env.vert_next[env.reflex][lb] - b[lb]
+        graze = _cross(wt, bp) * _cross(wt, bn) >= 0
+        return np.concatenate([keep_a, one_side & graze])
+
+    def _free_near(self) -> shapely.Geometry:
+        """The free space grown by ``tol_lab`` (cached, prepared): lines that graze
+        obstacles are unobstructed."""
+        got = getattr(self, "_free_grown", None)
+        if got is None:
+            got = self._free_grown = shapely.buffer(self.free, self.tol_lab)
+            shapely.prepare(got)
+        return got
 
     def _check_time(self) -> None:
         if self.deadline is not None and time.monotonic() > self.deadline:
