@@ -268,21 +268,23 @@ class Sweeper:
         dist = np.abs(_cross(d[:, None, :], table[None, :, :] - v[:, None, :])) / np.maximum(
             ln[:, None], 1e-300
         )
-        on = dist <= self.tol_lab
         keys = np.full((len(v), 2), -1, dtype=np.int64)
-        fixed = tid < self.n_fixed
-        for e in range(len(v)):
-            cand = np.flatnonzero(on[e])
-            if len(cand) < 2:
-                continue
-            # two distinct positions; prefer fixed anchors, then moving ones
-            order = cand[np.argsort(~fixed[cand], kind="stable")]
-            a = order[0]
-            far = np.abs(table[order] - table[a]).max(axis=1) > self.tol_lab
-            if not far.any():
-                continue
-            b = order[np.flatnonzero(far)[0]]
-            keys[e] = sorted((int(tid[a]), int(tid[b])))
+        # two distinct positions on the line; prefer fixed anchors, then moving ones (in
+        # table order): the first candidate in that order, then the first one away from it
+        perm = np.argsort(tid >= self.n_fixed, kind="stable")
+        on = (dist <= self.tol_lab)[:, perm]
+        rows = np.flatnonzero(on.any(axis=1))
+        if len(rows) == 0:
+            return keys
+        on = on[rows]
+        tab = table[perm]
+        a = np.argmax(on, axis=1)
+        far = on & (np.abs(tab[None, :, :] - tab[a][:, None, :]).max(axis=2) > self.tol_lab)
+        ok = far.any(axis=1)
+        b = np.argmax(far, axis=1)
+        ids = tid[perm]
+        pair = np.sort(np.stack([ids[a], ids[b]], axis=1), axis=1)
+        keys[rows[ok]] = pair[ok]
         return keys
 
     # -------------------------------------------------------------- point test
