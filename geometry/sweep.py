@@ -699,9 +699,10 @@ class Sweeper:
     def _refine_births(self, ts: list, q0, dq, frame, stats) -> list:
         """Add sample times where the eroded target's shadow has a component that
         neither neighbouring sample's shadow meets (a shadow born and dying in
-        between); bisect up to ``max_depth`` times."""
-        if self.strips is not None:
-            return ts
+        between); bisect up to ``max_depth`` times.  With overlap strips (5.2) the eroded
+        target's whole outline counts as wanted: its shadow bounds the full target's
+        shadows, which the 5.2 shadows contain, so a shadow of the full target born in
+        between is caught here too (and the 5.2 region stays inside R(G))."""
         todo = [(a, b, 0) for a, b in zip(ts[:-1], ts[1:], strict=True)]
         out = set(ts)
         while todo:
