@@ -679,9 +679,8 @@ class Sweeper:
         is not already inside ``known`` (rotating into their own shadow)."""
         if not edges:
             return []
-        tt = np.array([t, toward])
-        ends = [self._ends(e, tt, q0, dq) for e in edges]
-        quads = np.array([[vs[0], vs[1], ve[1], ve[0]] for vs, ve in ends])
+        vs, ve = self._ends_many(edges, np.array([[t, toward]]), q0, dq)  # (E, 2, 2) each
+        quads = np.stack([vs[:, 0], vs[:, 1], ve[:, 1], ve[:, 0]], axis=1)
         ok = np.isfinite(quads).all(axis=(1, 2))
         polys = shapely.polygons(np.where(ok[:, None, None], quads, 0.0))
         polys = shapely.make_valid(polys)
@@ -790,17 +789,22 @@ class Sweeper:
                 t_ok = np.where(good, tm, t_ok)
                 t_bad = np.where(good, t_bad, tm)
             t_end[dying] = t_ok
+        # the ends on the grid are vs, ve; those at the death times in one batch
+        if len(dying):
+            da, db = self._ends_many([edges[i] for i in dying], t_end[dying][:, None], q0, dq)
         quads, ends = [], []
-        for i, e in enumerate(edges):
+        for i in range(len(edges)):
             k = int(n_ok[i])
             if k == 0:
                 ends.append(ta)
                 continue
-            tk = ts[:k] if k == len(ts) else np.append(ts[:k], t_end[i])
-            ends.append(float(tk[-1]))
-            if len(tk) < 2:
+            a, b = vs[i, :k], ve[i, :k]
+            if k < len(ts):
+                j = int(np.searchsorted(dying, i))
+                a, b = np.vstack([a, da[j]]), np.vstack([b, db[j]])
+            ends.append(float(ts[k - 1]) if k == len(ts) else float(t_end[i]))
+            if len(a) < 2:
                 continue
-            a, b = self._ends(e, tk, q0, dq)
             quads.append(np.stack([a[:-1], a[1:], b[1:], b[:-1]], axis=1))
         if not quads:
             return [], ends
