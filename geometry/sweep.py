@@ -40,7 +40,11 @@ interval but the traces leave part of it uncovered (an edge configuration born
 and gone in between), and where the shadow of the eroded target (the part of A
 common to the whole interval, whose shadow contains every S(t) there) has a
 component that neither neighbouring shadow meets (a shadow born and gone in
-between).  What this does not prove is listed in docs/DESIGN.md.
+between), and once between consecutive *collinearity events* (:meth:`Sweeper._events`:
+a moving anchor crossing a line through two obstacle corners or an obstacle edge, a line
+through two target vertices crossing a corner), where a shadow can be born as a segment
+that continues a known shadow edge (issue 26.3, 26.4).  What this does not prove is
+listed in docs/DESIGN.md.
 """
 
 from __future__ import annotations
