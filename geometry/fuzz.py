@@ -19,7 +19,8 @@ demands equality up to the output's rounding.
 * ``outside``: area outside the free space (or inside the target) above 1e-9 D^2;
 * ``inclusion``: complete ⊆ partial, translating ⊆ stationary at every vertex of G, any
   orientation ⊆ fixed orientation, recognizable ⊆ both complete regions, swept partial
-  (``conservative=True``) ⊆ stationary partial, violated by more than 1e-8 D^2;
+  (``conservative=True``) ⊆ stationary partial at the vertices of G and at three sampled
+  configurations (two on its boundary, one inside), violated by more than 1e-8 D^2;
 * ``unsafe``: a sampled member of a complete region that an independent segment test
   finds blind to part of the target (points within 1e-6 D of the region's boundary are
   skipped); a sampled member of the stationary partial region that sees no sampled point
@@ -33,8 +34,9 @@ demands equality up to the output's rounding.
 
 * ``frame`` (``frames=True``, issue 26): the scene scaled by 1e-3 and 1e3 and moved to UTM
   coordinates (inexact maps: the inputs differ by rounding), regions mapped back, differ
-  by more than 1e-7 D^2; with ``swept`` and polygonal G/H also the 5.2 region ⊆ R(G), R(H)
-  and ⊆ the stationary recognizable region of a vertex pair.
+  by more than 1e-7 D^2; with ``swept`` also the swept partial region and (polygonal G/H)
+  the 5.2 recognizable region, up to their tracing tolerance (1e-4 D); and the 5.2 region
+  ⊆ R(G), R(H) and ⊆ the stationary recognizable region of a vertex pair.
 
 ``contacts=True`` (``--contacts``) adds the scene families issue 26 found missing:
 near-duplicate target vertices, flush obstacles over both ends of a target edge, a target
@@ -664,6 +666,17 @@ def check_scene(
                 {},
             )
             incl(p_in, pv, "translating ⊆ stationary (partial)")
+        if len(s.goal) > 1:
+            # ... and at sampled configurations of G: on its boundary (where the sweep
+            # runs, between its samples: issue 26.3) and inside it
+            for qx, qy in _sample_configs(s.goal_geom, rng):
+                pq = _timed(
+                    lambda qx=qx, qy=qy: partial_region(s, target_at=(qx, qy, theta)),
+                    "partial at sampled q",
+                    out,
+                    {},
+                )
+                incl(p_in, pq, "translating ⊆ stationary at sampled q (partial)")
         if poly_gh:
             r52 = run(
                 "recognizable partial 5.2",
@@ -716,7 +729,7 @@ def check_scene(
                     )
                     incl(r52, rs, "recognizable 5.2 ⊆ stationary recognizable")
     if frames:
-        _check_frames(s, d, q_at, theta, out)
+        _check_frames(s, d, q_at, theta, out, swept=swept, poly_gh=poly_gh)
     if translate:
         k = int(rng.integers(1, 6))
         unit = math.ldexp(1.0, math.ceil(math.log2(D)))
@@ -773,13 +786,56 @@ def _mapped(d: dict, k: float, ox: float, oy: float) -> dict:
     return out
 
 
+def _sample_configs(g: shapely.Geometry, rng: np.random.Generator) -> list[tuple[float, float]]:
+    """Two reference points on the boundary of the polygon ``g`` (not at a vertex) and
+    one inside it."""
+    b = g.exterior
+    out = [b.interpolate(float(t), normalized=True) for t in rng.uniform(0.0, 1.0, 2)]
+    out.append(g.representative_point())
+    return [(float(p.x), float(p.y)) for p in out]
+
+
+def _swept_differ(a: shapely.Geometry, b: shapely.Geometry, tol: float) -> float:
+    """Area of ``a`` outside ``b`` grown by ``tol`` plus that of ``b`` outside ``a`` grown
+    by ``tol``: two swept answers traced to within ``tol`` (each in its own frame, so
+    their samples differ by rounding) agree up to that."""
+    return (
+        shapely.difference(a, shapely.buffer(b, tol)).area
+        + shapely.difference(b, shapely.buffer(a, tol)).area
+    )
+
+
 def _check_frames(
-    s: Scene, d: dict, q_at: tuple[float, float, float], theta: float, out: list[Finding]
+    s: Scene,
+    d: dict,
+    q_at: tuple[float, float, float],
+    theta: float,
+    out: list[Finding],
+    *,
+    swept: bool = False,
+    poly_gh: bool = False,
 ) -> None:
     """Issue 26 item 9: the regions of the scene mapped into another frame (inexactly:
     the inputs differ by rounding, ~1e-10 D), mapped back, equal the originals to
-    1e-7 D^2 (findings ``frame``)."""
+    1e-7 D^2 (findings ``frame``).  With ``swept`` also the swept partial region and
+    (``poly_gh``) the 5.2 recognizable region (issue 25 item 7), compared up to their
+    tracing tolerance ``tol`` (1e-4 D, :func:`_swept_differ`)."""
     D = s.diameter
+    sw: list[tuple[str, Callable]] = []
+    if swept and len(s.goal) > 1:
+        sw.append(("partial in", lambda sc: partial_region(sc, target_in="goal", theta=theta)))
+    if swept and poly_gh:
+        sw.append(
+            ("recognizable 5.2", lambda sc: recognizable_region(sc, model="partial", theta=theta))
+        )
+    base = {}
+    for name, fn in sw:
+        try:
+            base[name] = fn(s)
+        except (SceneError, NotImplementedError):
+            continue
+        except Exception as e:  # noqa: BLE001
+            out.append(Finding("crash", name, f"{type(e).__name__}: {e}"))
     for fname, (k, ox, oy) in FRAMES.items():
         if fname == "utm":
             # a room of about 10 m first (an exact power-of-two scale): a 1e-6 m scene at
@@ -806,6 +862,20 @@ def _check_frames(
                 continue
             back = shapely.transform(b, lambda c, k=k, ox=ox, oy=oy: (c - [ox, oy]) / k)
             diff = shapely.symmetric_difference(a, back).area
+            if diff > 1e-7 * D * D:
+                out.append(Finding("frame", f"{name} ({fname})", f"{diff / D**2:.3g} D^2"))
+        for name, fn in sw:
+            if name not in base:
+                continue
+            try:
+                b = fn(t)
+            except (SceneError, NotImplementedError):
+                continue
+            except Exception as e:  # noqa: BLE001
+                out.append(Finding("crash", f"{name} ({fname})", f"{type(e).__name__}: {e}"))
+                continue
+            back = shapely.transform(b, lambda c, k=k, ox=ox, oy=oy: (c - [ox, oy]) / k)
+            diff = _swept_differ(base[name], back, 1e-4 * D)
             if diff > 1e-7 * D * D:
                 out.append(Finding("frame", f"{name} ({fname})", f"{diff / D**2:.3g} D^2"))
 

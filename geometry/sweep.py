@@ -40,7 +40,11 @@ interval but the traces leave part of it uncovered (an edge configuration born
 and gone in between), and where the shadow of the eroded target (the part of A
 common to the whole interval, whose shadow contains every S(t) there) has a
 component that neither neighbouring shadow meets (a shadow born and gone in
-between).  What this does not prove is listed in docs/DESIGN.md.
+between), and once between consecutive *collinearity events* (:meth:`Sweeper._events`:
+a moving anchor crossing a line through two obstacle corners or an obstacle edge, a line
+through two target vertices crossing a corner), where a shadow can be born as a segment
+that continues a known shadow edge (issue 26.3, 26.4).  What this does not prove is
+listed in docs/DESIGN.md.
 """
 
 from __future__ import annotations
@@ -268,21 +272,23 @@ class Sweeper:
         dist = np.abs(_cross(d[:, None, :], table[None, :, :] - v[:, None, :])) / np.maximum(
             ln[:, None], 1e-300
         )
-        on = dist <= self.tol_lab
         keys = np.full((len(v), 2), -1, dtype=np.int64)
-        fixed = tid < self.n_fixed
-        for e in range(len(v)):
-            cand = np.flatnonzero(on[e])
-            if len(cand) < 2:
-                continue
-            # two distinct positions; prefer fixed anchors, then moving ones
-            order = cand[np.argsort(~fixed[cand], kind="stable")]
-            a = order[0]
-            far = np.abs(table[order] - table[a]).max(axis=1) > self.tol_lab
-            if not far.any():
-                continue
-            b = order[np.flatnonzero(far)[0]]
-            keys[e] = sorted((int(tid[a]), int(tid[b])))
+        # two distinct positions on the line; prefer fixed anchors, then moving ones (in
+        # table order): the first candidate in that order, then the first one away from it
+        perm = np.argsort(tid >= self.n_fixed, kind="stable")
+        on = (dist <= self.tol_lab)[:, perm]
+        rows = np.flatnonzero(on.any(axis=1))
+        if len(rows) == 0:
+            return keys
+        on = on[rows]
+        tab = table[perm]
+        a = np.argmax(on, axis=1)
+        far = on & (np.abs(tab[None, :, :] - tab[a][:, None, :]).max(axis=2) > self.tol_lab)
+        ok = far.any(axis=1)
+        b = np.argmax(far, axis=1)
+        ids = tid[perm]
+        pair = np.sort(np.stack([ids[a], ids[b]], axis=1), axis=1)
+        keys[rows[ok]] = pair[ok]
         return keys
 
     # -------------------------------------------------------------- point test
@@ -483,6 +489,12 @@ class Sweeper:
         if not float(np.hypot(*dq)) > 0:
             return [frames[0.0][0]], stats
         ts = self._refine_births(ts, q0, dq, frame, stats)
+        # one sample between consecutive collinearity events (shadows born on a line)
+        ev = np.concatenate([[0.0], self._events(q0, dq), [1.0]])
+        mids = {float(t) for t in 0.5 * (ev[1:] + ev[:-1])}
+        ts = sorted(set(ts) | mids)
+        for t in ts:
+            frame(t)
         pieces = [frames[t][0] for t in ts]
         cover: dict[tuple, list] = {}
         # (t, key): an edge on that line at sample t is confirmed by the exact point test
@@ -517,6 +529,151 @@ class Sweeper:
                 todo += [(a, gap, depth + 1), (gap, b, depth + 1)]
         return pieces, stats
 
+    def _events(self, q0: np.ndarray, dq: np.ndarray) -> np.ndarray:
+        """Times in (0, 1), sorted, at which the target moving along ``q0 + t dq`` meets
+        a *collinearity event*: a moving anchor (target vertex or end of a wanted piece)
+        crosses the line through two convex obstacle corners whose joining line is
+        tangent at both, or through an obstacle edge; or the line through two target
+        vertices crosses a convex obstacle corner.  Only events whose line is
+        unobstructed between its anchors count.
+
+        At such an event two shadow-edge lines coincide, and a shadow can be born as a
+        segment on that line (it then grows from a line that continues an edge of an
+        existing shadow, so the eroded-target test of :meth:`_refine_births`, which
+        looks for shadow components apart from the known ones, does not see it: fuzz
+        issue 26.3/26.4).  Sampling once between consecutive events catches such a
+        shadow at a time it has area, and its edges are then traced both ways."""
+        b, i, j = self._event_lines()
+        env = self.env
+        # obstacle edges with a convex end (a beam can graze along them past that end)
+        cvx = np.flatnonzero(env.reflex)
+        p0 = np.vstack([b[i], env.vert[cvx], env.vert[cvx]])
+        p1 = np.vstack([b[j], env.vert_next[cvx], env.vert_prev[cvx]])
+        w = p1 - p0
+        # moving anchors at t = 0 and their velocities (target vertices: dq; ends of the
+        # wanted pieces slide along their strip segment)
+        q0v = q0[None, :]
+        mov0 = [self.ring0 + q0v]
+        vel = [np.broadcast_to(dq, self.ring0.shape)]
+        if len(self._cut_segs):
+            ids = self.n_fixed + self.m + np.arange(len(self._cut_segs))
+            with np.errstate(invalid="ignore"):  # an edge parallel to its strip segment
+                c0 = self.pos(ids, np.repeat(q0v, len(ids), 0))
+                c1 = self.pos(ids, np.repeat((q0 + dq)[None, :], len(ids), 0))
+            ok = np.isfinite(c0).all(axis=1) & np.isfinite(c1).all(axis=1)
+            mov0.append(c0[ok])
+            vel.append(c1[ok] - c0[ok])
+        x0, vx = np.vstack(mov0), np.vstack(vel)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            # x0 + t vx on the line (p0, w)
+            ta = _cross(w[:, None, :], p0[:, None, :] - x0[None]) / _cross(
+                w[:, None, :], vx[None]
+            )
+            ii, kk = np.triu_indices(self.m, 1)
+            wt = self.ring0[kk] - self.ring0[ii]
+            a0 = self.ring0 + q0v
+            tb = _cross(wt[None], b[:, None, :] - a0[ii][None]) / _cross(wt, dq)[None]
+        lo, hi = 1e-9, 1 - 1e-9
+        la, xa = np.nonzero(np.isfinite(ta) & (ta > lo) & (ta < hi))
+        ta = ta[la, xa]
+        lb, pb = np.nonzero(np.isfinite(tb) & (tb > lo) & (tb < hi))
+        tb = tb[lb, pb]
+        # unobstructed: the line's piece spanning its three points lies in the free space
+        xs = x0[xa] + ta[:, None] * vx[xa]
+        pts = np.stack([p0[la], p1[la], xs], axis=1)  # (A, 3, 2)
+        u = w[la] / np.maximum(np.hypot(w[la, 0], w[la, 1]), 1e-300)[:, None]
+        s_ = np.einsum("akj,aj->ak", pts - pts[:, :1], u)
+        seg_a = np.stack(
+            [
+                pts[np.arange(len(pts)), np.argmin(s_, axis=1)],
+                pts[np.arange(len(pts)), np.argmax(s_, axis=1)],
+            ],
+            axis=1,
+        )
+        ai = a0[ii[pb]] + tb[:, None] * dq
+        ak = a0[kk[pb]] + tb[:, None] * dq
+        bb = b[lb]
+        near = np.where(
+            (np.hypot(*(ai - bb).T) <= np.hypot(*(ak - bb).T))[:, None], ai, ak
+        )
+        seg_b = np.stack([bb, near], axis=1)
+        segs = np.concatenate([seg_a, seg_b])
+        t = np.concatenate([ta, tb])
+        if len(t) == 0:
+            return t
+        keep = self._tangent_events(xa, ta, la, w, lb, pb, b, ii, kk)
+        keep &= shapely.covers(self._free_near(), shapely.linestrings(segs))
+        cut = np.flatnonzero(xa >= self.m)  # ends of wanted pieces: on their edge then?
+        if len(cut):
+            k = xa[cut] - self.m
+            kk_ = np.flatnonzero(np.isfinite(c0).all(axis=1) & np.isfinite(c1).all(axis=1))[k]
+            i_e = self._cut_edge[kk_]
+            a_e = self.ring0[i_e] + q0 + ta[cut, None] * dq
+            e_e = self.edge0[i_e]
+            s_e = self._cut_segs[kk_]
+            x_e = xs[cut]
+            u_e = np.einsum("ij,ij->i", x_e - a_e, e_e) / np.einsum("ij,ij->i", e_e, e_e)
+            d_s = s_e[:, 2:] - s_e[:, :2]
+            w_e = np.einsum("ij,ij->i", x_e - s_e[:, :2], d_s) / np.maximum(
+                np.einsum("ij,ij->i", d_s, d_s), 1e-300
+            )
+            keep[cut] &= (u_e >= -1e-9) & (u_e <= 1 + 1e-9) & (w_e >= -1e-9) & (w_e <= 1 + 1e-9)
+        t = np.unique(t[keep])
+        if len(t) > 1:  # merge events closer than the tracing can tell apart
+            t = t[np.concatenate([[True], np.diff(t) > 1e-9])]
+        return t
+
+    def _tangent_events(self, xa, ta, la, w, lb, pb, b, ii, kk) -> np.ndarray:
+        """Which events can bound a shadow: the moving vertex's line is tangent to the
+        target there (both ring neighbours on one side), the line through two target
+        vertices has the whole target on one side and grazes the obstacle at ``b``."""
+        m = self.m
+        keep_a = np.ones(len(ta), dtype=bool)
+        tv = xa < m
+        if tv.any():
+            k = xa[tv]
+            r0 = self.ring0
+            keep_a[tv] = _tangent(w[la[tv]], r0[(k - 1) % m] - r0[k], r0[(k + 1) % m] - r0[k])
+        wt = self.ring0[kk[pb]] - self.ring0[ii[pb]]
+        rel = self.ring0[None, :, :] - self.ring0[ii[pb]][:, None, :]
+        side = _cross(wt[:, None, :], rel)
+        zero = np.abs(side) <= 1e-9 * np.hypot(wt[:, 0], wt[:, 1])[:, None] * np.hypot(
+            rel[..., 0], rel[..., 1]
+        )
+        one_side = ~(((side > 0) & ~zero).any(axis=1) & ((side < 0) & ~zero).any(axis=1))
+        env = self.env
+        bp = env.vert_prev[env.reflex][lb] - b[lb]
+        bn = env.vert_next[env.reflex][lb] - b[lb]
+        graze = _tangent(wt, bp, bn)
+        return np.concatenate([keep_a, one_side & graze])
+
+    def _event_lines(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Convex obstacle corners and the pairs (i, j) of them whose joining line is
+        tangent at both, with collinear neighbours counting as tangent (cached).  Unlike
+        :meth:`_corners_and_tangents` the test has a tolerance: rows of collinear corners
+        and flush edges are where the events are, and a bare sign test there flips with
+        the rounding of the frame (fuzz seed 8103, scaled by 1e3)."""
+        got = getattr(self, "_ev_lines", None)
+        if got is None:
+            env = self.env
+            b = env.vert[env.reflex]
+            bp = env.vert_prev[env.reflex] - b
+            bn = env.vert_next[env.reflex] - b
+            i, j = np.triu_indices(len(b), 1)
+            w = b[j] - b[i]
+            ok = _tangent(w, bp[i], bn[i]) & _tangent(w, bp[j], bn[j])
+            got = self._ev_lines = (b, i[ok], j[ok])
+        return got
+
+    def _free_near(self) -> shapely.Geometry:
+        """The free space grown by ``tol_lab`` (cached, prepared): lines that graze
+        obstacles are unobstructed."""
+        got = getattr(self, "_free_grown", None)
+        if got is None:
+            got = self._free_grown = shapely.buffer(self.free, self.tol_lab)
+            shapely.prepare(got)
+        return got
+
     def _check_time(self) -> None:
         if self.deadline is not None and time.monotonic() > self.deadline:
             raise _Expired
@@ -526,9 +683,8 @@ class Sweeper:
         is not already inside ``known`` (rotating into their own shadow)."""
         if not edges:
             return []
-        tt = np.array([t, toward])
-        ends = [self._ends(e, tt, q0, dq) for e in edges]
-        quads = np.array([[vs[0], vs[1], ve[1], ve[0]] for vs, ve in ends])
+        vs, ve = self._ends_many(edges, np.array([[t, toward]]), q0, dq)  # (E, 2, 2) each
+        quads = np.stack([vs[:, 0], vs[:, 1], ve[:, 1], ve[:, 0]], axis=1)
         ok = np.isfinite(quads).all(axis=(1, 2))
         polys = shapely.polygons(np.where(ok[:, None, None], quads, 0.0))
         polys = shapely.make_valid(polys)
@@ -565,11 +721,12 @@ class Sweeper:
     def _refine_births(self, ts: list, q0, dq, frame, stats) -> list:
         """Add sample times where the eroded target's shadow has a component that
         neither neighbouring sample's shadow meets (a shadow born and dying in
-        between); bisect up to ``max_depth`` times.  With strips (5.2) the eroded
-        target's shadow is that of its whole outline: it holds every S(q) of the whole
-        outline, which the S(q) of the wanted pieces contain, so the samples it adds catch
-        those births (fuzz seed 411063, mixed G/H); births of shadows that exist only
-        because pieces are unwanted are not detected by it."""
+        between); bisect up to ``max_depth`` times.  With overlap strips (5.2) the eroded
+        target's whole outline counts as wanted: its shadow bounds the full target's
+        shadows, which the 5.2 shadows contain, so a shadow of the full target born in
+        between is caught here too (and the 5.2 region stays inside R(G); fuzz seed 411063,
+        mixed G/H).  Births of shadows that exist only because pieces are unwanted are not
+        detected by it."""
         todo = [(a, b, 0) for a, b in zip(ts[:-1], ts[1:], strict=True)]
         out = set(ts)
         while todo:
@@ -638,17 +795,22 @@ class Sweeper:
                 t_ok = np.where(good, tm, t_ok)
                 t_bad = np.where(good, t_bad, tm)
             t_end[dying] = t_ok
+        # the ends on the grid are vs, ve; those at the death times in one batch
+        if len(dying):
+            da, db = self._ends_many([edges[i] for i in dying], t_end[dying][:, None], q0, dq)
         quads, ends = [], []
-        for i, e in enumerate(edges):
+        for i in range(len(edges)):
             k = int(n_ok[i])
             if k == 0:
                 ends.append(ta)
                 continue
-            tk = ts[:k] if k == len(ts) else np.append(ts[:k], t_end[i])
-            ends.append(float(tk[-1]))
-            if len(tk) < 2:
+            a, b = vs[i, :k], ve[i, :k]
+            if k < len(ts):
+                j = int(np.searchsorted(dying, i))
+                a, b = np.vstack([a, da[j]]), np.vstack([b, db[j]])
+            ends.append(float(ts[k - 1]) if k == len(ts) else float(t_end[i]))
+            if len(a) < 2:
                 continue
-            a, b = self._ends(e, tk, q0, dq)
             quads.append(np.stack([a[:-1], a[1:], b[1:], b[:-1]], axis=1))
         if not quads:
             return [], ends
@@ -770,6 +932,17 @@ class Sweeper:
         res = np.zeros(len(flat_p), dtype=bool)
         res[finite] = self.blind(flat_p[finite], flat_q[finite])
         return res.reshape(probes.shape[:-1]).all(axis=-1) & (ln > 0)
+
+
+def _tangent(w: np.ndarray, bp: np.ndarray, bn: np.ndarray, rel: float = 1e-9) -> np.ndarray:
+    """Row by row: does the line of direction ``w`` through a corner keep the corner's
+    two edges (``bp``, ``bn``: from the corner to its neighbours) on one side?  An edge
+    within ``rel`` (relative sine) of the line counts as on it, i.e. on either side."""
+    cp, cn = _cross(w, bp), _cross(w, bn)
+    lw = np.hypot(w[..., 0], w[..., 1])
+    zp = np.abs(cp) <= rel * lw * np.hypot(bp[..., 0], bp[..., 1])
+    zn = np.abs(cn) <= rel * lw * np.hypot(bn[..., 0], bn[..., 1])
+    return zp | zn | (cp * cn > 0)
 
 
 def _between(s: np.ndarray) -> np.ndarray:
