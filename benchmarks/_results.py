@@ -43,6 +43,7 @@ NAMES = (
     "swept",
     "swept_accuracy",
     "train_profile",
+    "train_study",
     "viewer_layers",
     "watch_oracle",
     "watch_declare",
