@@ -35,6 +35,7 @@ DEFAULT_OUT = Path("runs") / "benchmarks"
 #: the benchmarks that write results (module names under ``benchmarks``)
 NAMES = (
     "envs",
+    "family_breakdown",
     "oracle",
     "policies",
     "real_maps",
