@@ -56,12 +56,7 @@ from .recognize import _accuracy, overlap_strips
 if TYPE_CHECKING:  # pragma: no cover
     from .scene import Scene
 
-__all__ = ["OUTER_ERODE", "SweptBounds", "hausdorff_bounds", "swept_bounds"]
-
-#: The union of the sampled shadows is eroded by this many snap-rounding grids (the
-#: overlays moved its boundary by less than 1.01 grid; GEOS's round buffer erodes by at
-#: least 0.98 of its distance), so what is left is inside the exact shadows.
-OUTER_ERODE = 8.0
+__all__ = ["SweptBounds", "hausdorff_bounds", "swept_bounds"]
 
 #: The Hausdorff distance is bounded on a grid of this many cells along the longer side
 #: of the gap's bounding box (:func:`hausdorff_bounds`).
@@ -178,9 +173,8 @@ def _side(
         shadows = [s for _, s in samples]
     grid = sink["grid"]
     union = union_all(shadows, grid_size=grid) if shadows else shapely.Polygon()
-    core = polygonal(shapely.buffer(union, -OUTER_ERODE * grid)) if not union.is_empty else union
     allowed = sink["allowed"]
-    outer = polygonal(shapely.difference(allowed, core))
+    outer = polygonal(shapely.difference(allowed, union))
     if eps_pos > 0:
         # shrink_for_position grows by a circumscribed polygon of radius r + 2 delta
         # (delta = 1e-9 * diag): keep that inside the eps disc, so outer stays outside E
