@@ -220,7 +220,8 @@ def _recognizable_bounds(
             scene, poly_name, theta, eps_pos, eps_aim, tol, budget, densify,
             strips=point_strips(target, point, *acc),
         )  # fmt: skip
-        still = _point_side(scene, point, theta, overlap_strips(target, poly, *acc), eps_pos, eps_aim)
+        vs_poly = overlap_strips(target, poly, *acc)
+        still = _point_side(scene, point, theta, vs_poly, eps_pos, eps_aim)
         return (
             polygonal(shapely.intersection(inner, still)),
             polygonal(shapely.intersection(outer, still)),

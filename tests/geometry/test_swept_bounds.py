@@ -110,11 +110,14 @@ def _violations(scene, inner, outer, pts, passes) -> tuple[list, list]:
     boundaries by MARGIN * D."""
     m = MARGIN * scene.diameter
     pp = shapely.points(pts)
-    d_in = shapely.distance(inner.boundary, pp) if not inner.is_empty else np.full(len(pts), np.inf)
-    d_out = shapely.distance(outer.boundary, pp) if not outer.is_empty else np.full(len(pts), np.inf)
+    far = np.full(len(pts), np.inf)
+    d_in = shapely.distance(inner.boundary, pp) if not inner.is_empty else far
+    d_out = shapely.distance(outer.boundary, pp) if not outer.is_empty else far
     in_inner = shapely.contains_xy(inner, pts[:, 0], pts[:, 1])
     in_outer = shapely.contains_xy(outer, pts[:, 0], pts[:, 1])
-    bad_inner = [tuple(p) for p, i, d, ok in zip(pts, in_inner, d_in, passes) if i and d > m and not ok]
+    bad_inner = [
+        tuple(p) for p, i, d, ok in zip(pts, in_inner, d_in, passes) if i and d > m and not ok
+    ]
     bad_outer = [
         tuple(p) for p, o, d, ok in zip(pts, in_outer, d_out, passes) if not o and d > m and ok
     ]
@@ -174,11 +177,19 @@ def test_the_check_fails_on_wrong_bounds():
     assert bad_inner, "a grown inner went unnoticed"
 
 
-@pytest.mark.parametrize("path", ["edr", "warehouse"])
-def test_recognizable_bounds_bracket_the_answers(path):
-    """5.2 (polygonal G and H): inner is the conservative answer, and both the default and
-    the conservative answers lie inside outer."""
-    scene = Scene.load(f"sensorplan_gym/scenes/{path}.json")
+RECOGNIZABLE = {
+    "edr": lambda: Scene.load("sensorplan_gym/scenes/edr.json"),
+    "warehouse": lambda: Scene.load("sensorplan_gym/scenes/warehouse.json"),
+    "fuzz-1-nonstar": lambda: _fuzzed(1),  # hull stand-in: whole-outline outer shadows
+    "fuzz-22-mixed-nonstar": lambda: _fuzzed(22),  # a point and a polygon
+}
+
+
+@pytest.mark.parametrize("name", list(RECOGNIZABLE))
+def test_recognizable_bounds_bracket_the_answers(name):
+    """5.2 (polygonal or mixed G and H): inner is the conservative answer, and both the
+    default and the conservative answers lie inside outer."""
+    scene = RECOGNIZABLE[name]()
     D = scene.diameter
     b = swept_bounds(scene, recognizable=True)
     cons = recognizable_region(scene, model="partial", theta=0.0, conservative=True)
@@ -194,3 +205,75 @@ def test_bad_arguments_name_the_problem():
         swept_bounds(scene)
     with pytest.raises(ValueError, match="densify"):
         swept_bounds(scene, target_in="goal", densify=-1)
+
+
+# ---- paper 5.2: polygonal G and H, wanted pieces built independently -------------------------
+
+
+def _truth_recognizable(scene: Scene, pts: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    """Per placement: for every sampled configuration q in G (in H), does it see a wanted
+    point of A_q (the outline minus the overlaps with the target anywhere in H (in G))?
+    Convex target: a wanted piece is seen when V(p) meets it on a front-facing edge."""
+    from tests.geometry.test_swept_partial import _wanted
+
+    oracle = VisOracle(scene)
+    groups = []
+    for me, other in ((scene.goal_geom, scene.failure_geom), (scene.failure_geom, scene.goal_geom)):
+        qs = _configs(me, rng, per_edge=40, inner=15)
+        rows = [
+            (seg, nrm, a0, j)
+            for j, q in enumerate(qs)
+            for seg, nrm, a0 in _wanted(scene, q, other, 0.0)
+        ]
+        segs, nrms, anchors, owner = (np.asarray(x) for x in zip(*rows, strict=True))
+        groups.append((segs, nrms, anchors, owner.astype(int), len(qs)))
+    ok = np.ones(len(pts), dtype=bool)
+    for k, p in enumerate(pts):
+        vis = oracle.visibility(p)
+        if vis.is_empty:
+            ok[k] = False
+            continue
+        shapely.prepare(vis)
+        for segs, nrms, anchors, owner, n_q in groups:
+            front = ((p - anchors) * nrms).sum(axis=1) > 0
+            seen = np.zeros(len(segs), dtype=bool)
+            lengths = shapely.length(shapely.intersection(vis, segs[front]))
+            seen[front] = lengths > 1e-9 * scene.diameter
+            ok[k] &= bool(np.bincount(owner[seen], minlength=n_q).astype(bool).all())
+    return ok
+
+
+@pytest.mark.parametrize("seed", [21, 22])
+def test_recognizable_bounds_hold_against_brute_force(seed):
+    from tests.geometry.test_swept_partial import _scene
+
+    scene = _scene(seed, convex_target=True)
+    D = scene.diameter
+    b = swept_bounds(scene, recognizable=True)
+    cons = recognizable_region(scene, model="partial", theta=0.0, conservative=True)
+    assert shapely.symmetric_difference(b.inner, cons).area <= 1e-12 * D * D
+    assert shapely.difference(b.inner, b.outer).area <= 1e-12 * D * D
+    areas = [
+        shapely.affinity.translate(scene.target_at(0, 0, 0.0), x, y)
+        for g in (scene.goal_geom, scene.failure_geom)
+        for x, y in np.asarray(g.exterior.coords)
+    ]
+    hull = shapely.union_all(
+        [shapely.convex_hull(shapely.union_all(areas[: len(areas) // 2])),
+         shapely.convex_hull(shapely.union_all(areas[len(areas) // 2 :]))]
+    )  # fmt: skip
+    space = shapely.difference(scene.free_space, shapely.buffer(hull, 1e-6 * D))
+    near = shapely.intersection(
+        space, shapely.buffer(shapely.union(b.inner.boundary, b.outer.boundary), 5e-3 * D)
+    )
+    rng = np.random.default_rng(seed)
+    pts = _placements(space, near, rng, 100)
+    passes = _truth_recognizable(scene, pts, rng)
+    bad_inner, bad_outer = _violations(scene, b.inner, b.outer, pts, passes)
+    assert not bad_inner, f"5.2 seed {seed}: inner placements that fail: {bad_inner[:5]}"
+    assert not bad_outer, f"5.2 seed {seed}: placements outside outer that pass: {bad_outer[:5]}"
+    assert (~passes).sum() >= 10 and passes.sum() >= 10
+    print(
+        f"5.2 seed {seed}: hausdorff <= {b.hausdorff / D:.2e} D, gap area "
+        f"{(b.outer.area - b.inner.area) / D**2:.2e} D^2"
+    )
