@@ -277,3 +277,22 @@ def test_recognizable_bounds_hold_against_brute_force(seed):
         f"5.2 seed {seed}: hausdorff <= {b.hausdorff / D:.2e} D, gap area "
         f"{(b.outer.area - b.inner.area) / D**2:.2e} D^2"
     )
+
+
+def test_uncertainty_and_densify_keep_the_bracket():
+    """eps_pos / eps_aim: inner is the conservative answer and inside outer, the default
+    answer inside outer; densify adds exact shadows, so outer can only shrink."""
+    scene = SCENES["fuzz-8-star"]()
+    D = scene.diameter
+    kw = dict(target_in="goal", eps_pos=0.01 * D, eps_aim=0.01)
+    b = swept_bounds(scene, **kw)
+    cons = partial_region(scene, conservative=True, **kw)
+    default = partial_region(scene, **kw)
+    assert shapely.symmetric_difference(b.inner, cons).area <= 1e-12 * D * D
+    assert shapely.difference(b.inner, b.outer).area <= 1e-12 * D * D
+    assert shapely.difference(default, b.outer).area <= 1e-12 * D * D
+    plain = swept_bounds(scene, target_in="goal")
+    dense = swept_bounds(scene, target_in="goal", densify=4)
+    assert dense.samples > plain.samples
+    assert shapely.difference(dense.outer, plain.outer).area <= 1e-12 * D * D
+    assert shapely.difference(dense.inner, dense.outer).area <= 1e-12 * D * D
