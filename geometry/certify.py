@@ -14,10 +14,11 @@ S(q) the stationary shadow (placements blind to every wanted point of A_q).
   deeper than tol* (docs/DESIGN.md, "What is and is not guaranteed": not proven;
   checked empirically, ``tests/geometry/test_swept_bounds.py``).
 * ``outer`` is ``allowed`` minus the union of the *sampled* stationary shadows S(q_k)
-  (q_k on the boundary of G, so in G), eroded by ``OUTER_ERODE`` snap-rounding grids.
-  Each S(q_k) is an exact stationary shadow (up to the snap-rounding of its overlay),
-  so it is a subset of the exact union and ``E ⊆ outer``.  This needs no claim about
-  the tracing between samples: it is proven given the stationary shadow (paper 3.2.1).
+  (q_k on the boundary of G, so in G).  Each S(q_k) is an exact stationary shadow, so
+  it is a subset of the exact union and ``E ⊆ outer``.  This needs no claim about the
+  tracing between samples: it is proven given the stationary shadow (paper 3.2.1), up
+  to the snap-rounding of the shadows' overlays (boundaries move by less than the
+  ~1e-12 D grid; a lit sliver narrower than it collapses into the shadow).
   For a non-star-shaped target with overlap strips (the certified stand-in of
   :mod:`geometry.nonstar`) the stand-in's shadows are not subsets of the exact ones;
   there the sampled shadows are the real outline's whole-outline stationary shadows
