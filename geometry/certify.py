@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
@@ -53,6 +54,7 @@ from ._shapes import ccw_ring, union_all
 from .mixed import _point_side, point_strips
 from .partial import _partial_region, _swept_region, swept_tol
 from .recognize import _accuracy, overlap_strips
+from .sweep import QueryTimeout
 
 if TYPE_CHECKING:  # pragma: no cover
     from .scene import Scene
@@ -169,7 +171,15 @@ def _side(
     if stand_in is not None and not stand_in.exact:
         # the hull stand-in's shadows are not inside the real ones: use the real outline's
         # whole-outline stationary shadows (blind to all of A_q => blind to its wanted part)
-        shadows = [_whole_shadow(scene, q, theta, eps_aim) for q, _ in samples]
+        shadows = []
+        for q, _ in samples:
+            if budget.deadline is not None and time.monotonic() > budget.deadline:
+                raise QueryTimeout(
+                    f"{budget.what} ran past its timeout while computing the outer bound's "
+                    f"shadows ({len(samples) - len(shadows)} of {len(samples)} left); raise "
+                    "timeout= or give timeout=None"
+                )
+            shadows.append(_whole_shadow(scene, q, theta, eps_aim))
     else:
         shadows = [s for _, s in samples]
     grid = sink["grid"]
