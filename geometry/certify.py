@@ -61,9 +61,11 @@ if TYPE_CHECKING:  # pragma: no cover
 
 __all__ = ["SweptBounds", "hausdorff_bounds", "swept_bounds"]
 
-#: The Hausdorff distance is bounded on a grid of this many cells along the longer side
-#: of the gap's bounding box (:func:`hausdorff_bounds`).
-HAUSDORFF_CELLS = 256
+#: The Hausdorff distance is bounded on cells refined from a grid of this many along the
+#: longer side of the gap's bounding box (:func:`hausdorff_bounds`) ...
+HAUSDORFF_CELLS = 64
+#: ... until the upper and lower bounds agree to this fraction of the upper one.
+HAUSDORFF_REL = 0.05
 
 
 @dataclass(frozen=True)
@@ -257,38 +259,48 @@ def _recognizable_bounds(
 
 
 def hausdorff_bounds(
-    inner: shapely.Geometry, outer: shapely.Geometry, cells: int = HAUSDORFF_CELLS
+    inner: shapely.Geometry,
+    outer: shapely.Geometry,
+    rel: float = HAUSDORFF_REL,
+    max_cells: int = 200_000,
 ) -> tuple[float, float]:
     """(upper, lower) bounds on sup_{x in outer} dist(x, inner), the Hausdorff distance
     of ``inner ⊆ outer`` (same units as the input).
 
-    The distance to ``inner`` is 1-Lipschitz.  On a square grid of step h over the gap
-    ``outer - inner``: the largest distance at a grid point inside the gap (or a vertex
-    of it) is a lower bound; every point of the gap is within h/sqrt(2) of a grid point
-    within h/sqrt(2) of the gap, so the largest distance at those points plus h/sqrt(2)
-    is an upper bound.  ``(inf, inf)`` when ``inner`` is empty and ``outer`` is not."""
+    The distance to ``inner`` is 1-Lipschitz.  Square cells (centre c, half-diagonal r)
+    cover the gap ``outer - inner``; a cell whose centre is farther than r from the gap
+    holds none of it, and the others bound the distance in them by dist(c, inner) + r
+    (upper).  Centres inside the gap and densified vertices of the gap give the lower
+    bound.  Cells that cannot beat the lower bound are dropped, the rest split in four,
+    until upper - lower <= ``rel`` * upper (or ``max_cells``, or 12 levels).  ``(inf,
+    inf)`` when ``inner`` is empty and ``outer`` is not."""
     gap = polygonal(shapely.difference(outer, inner))
     if gap.is_empty or gap.area == 0.0:
         return 0.0, 0.0
     if inner.is_empty:
         return math.inf, math.inf
     x0, y0, x1, y1 = gap.bounds
-    h = max(x1 - x0, y1 - y0) / cells
-    r = h / math.sqrt(2.0)
-    xs = np.arange(x0 - h, x1 + 2 * h, h)
-    ys = np.arange(y0 - h, y1 + 2 * h, h)
-    gx, gy = (a.ravel() for a in np.meshgrid(xs, ys))
-    near = shapely.buffer(gap, r * 1.01, quad_segs=2)  # the round buffer's chords: r / cos
-    shapely.prepare(near)
-    keep = shapely.contains_xy(near, gx, gy)
-    pts = np.column_stack([gx[keep], gy[keep]])
+    h = max(x1 - x0, y1 - y0) / HAUSDORFF_CELLS
+    xs = np.arange(x0 + h / 2, x1 + h, h)
+    ys = np.arange(y0 + h / 2, y1 + h, h)
+    c = np.column_stack([a.ravel() for a in np.meshgrid(xs, ys)])
     verts = shapely.get_coordinates(shapely.segmentize(gap, h / 4))
-    d_grid = _dist(inner, pts)
-    d_vert = _dist(inner, verts)
-    shapely.prepare(gap)
-    in_gap = shapely.contains_xy(gap, pts[:, 0], pts[:, 1])
-    lower = max(float(d_vert.max(initial=0.0)), float(d_grid[in_gap].max(initial=0.0)))
-    upper = max(float(d_grid.max(initial=0.0)) + r, lower)
+    lower = float(_dist(inner, verts).max(initial=0.0))
+    upper = math.inf
+    for _ in range(12):
+        r = h / math.sqrt(2.0)
+        dg = _dist(gap, c)
+        c, dg = c[dg <= r], dg[dg <= r]
+        di = _dist(inner, c)
+        lower = max(lower, float(di[dg == 0.0].max(initial=0.0)))
+        bound = di + r
+        upper = max(lower, float(bound.max(initial=0.0)))
+        if upper - lower <= rel * upper or 4 * len(c) > max_cells:
+            break
+        c = c[bound > lower]
+        h /= 2
+        q = h / 2
+        c = (c[:, None, :] + np.array([[-q, -q], [q, -q], [-q, q], [q, q]])[None]).reshape(-1, 2)
     return upper, lower
 
 
