@@ -8,6 +8,7 @@ All functions take a :class:`Scene` and return shapely geometries in world
 coordinates; angles are radians.  The package does not depend on Gymnasium.
 """
 
+from .certify import SweptBounds, swept_bounds
 from .complete import complete_region
 from .partial import partial_region
 from .recognize import overlap_segments, recognizable_region
@@ -19,8 +20,10 @@ __all__ = [
     "Scene",
     "SceneError",
     "SensorSpec",
+    "SweptBounds",
     "complete_region",
     "overlap_segments",
     "partial_region",
     "recognizable_region",
+    "swept_bounds",
 ]

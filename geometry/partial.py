@@ -189,8 +189,12 @@ def _swept_region(
     conservative: bool,
     strips: list[shapely.Geometry] | None = None,
     budget: Budget | None = None,
+    sink: dict | None = None,
+    extra_samples: int = 0,
 ) -> shapely.Geometry:
-    """The partial region of a target translating through ``target_in``."""
+    """The partial region of a target translating through ``target_in``.  ``sink``: a
+    dict that receives the sampled exact shadows and the pieces of the answer
+    (:mod:`geometry.certify`)."""
     budget = budget or Budget()
     if theta is None:
         raise NotImplementedError(ROTATING_PARTIAL)
@@ -214,6 +218,8 @@ def _swept_region(
         deadline=budget.deadline,
         progress=budget.report if budget.progress is not None else None,
         what=budget.what,
+        samples=None if sink is None else sink.setdefault("samples", []),
+        extra_samples=extra_samples,
     )
     if conservative:
         # tol: the traced arcs' chords; grid: the snap-rounding of the union (sweep.py)
@@ -224,6 +230,8 @@ def _swept_region(
         # the pockets swept through the region are dropped like shadows (eps_pos too)
         shadows = shapely.union(shadows, pocket_area(target, region))
     out = polygonal(shapely.difference(allowed, shadows))
+    if sink is not None:
+        sink.update(allowed=allowed, grid=stats["grid"], stand_in=stand_in, region=region)
     if eps_pos > 0:
         out = shrink_for_position(out, allowed, eps_pos)
     return out

@@ -1047,6 +1047,8 @@ def swept_shadows(
     deadline: float | None = None,
     progress: Callable[[int, int], None] | None = None,
     what: str = "the swept query",
+    samples: list | None = None,
+    extra_samples: int = 0,
 ) -> tuple[shapely.Geometry, dict]:
     """Union of the partial-visibility shadows S(q) over the reference points q
     of ``region`` (a Point or Polygon), for the target outline ``target``
@@ -1074,6 +1076,12 @@ def swept_shadows(
     robust overlay: its output is valid and every point of it lies within
     ``grid / sqrt(2)`` of the exact union and vice versa; ``conservative=True`` grows the
     union by ``tol + grid`` to cover that too.
+
+    ``samples``: a list to which ``(q, shadow)`` is appended for every exact stationary
+    shadow the sweep sampled (``q`` the configuration, a reference point of ``region``
+    in the caller's frame; used by :mod:`geometry.certify` for the outer bound), and
+    for ``extra_samples`` more configurations evenly spaced inside every edge of the
+    region's boundary (those shadows are not part of the union returned).
     """
     c = star_center(target)
     if c is None:
@@ -1117,6 +1125,16 @@ def swept_shadows(
             if progress is not None:
                 progress(done + 1, len(segs))
     stats["grid"] = sw.grid
+    if samples is not None:
+        if region.geom_type == "Point":
+            samples.append((np.array([region.x, region.y]) - c, pieces[0]))
+        else:
+            samples.extend((np.array(k) - c, v[0]) for k, v in sw._frames.items())
+            ts = np.arange(1, extra_samples + 1) / (extra_samples + 1)
+            for a, b in segs:
+                for t in ts:
+                    q = a + t * (b - a)
+                    samples.append((q - c, sw.shadow(q)[0]))
     return polygonal(shapely.union_all(pieces, grid_size=sw.grid)), stats
 
 

@@ -1,0 +1,326 @@
+"""Certified swept answers (issue 25 item 2): an inner and an outer region around the
+exact answer of a swept query, and the Hausdorff distance between them.
+
+Swept queries: :func:`geometry.partial_region` with ``target_in=`` (paper 3.2.2) and
+:func:`geometry.recognizable_region` with ``model="partial"`` and a polygonal G or H
+(paper 5.2, also mixed point/polygon).  Their exact answer is
+
+    E = allowed - U_{q in G} S(q),   allowed = free space - (A (+) G),
+
+S(q) the stationary shadow (placements blind to every wanted point of A_q).
+
+* ``inner`` is what ``conservative=True`` returns: the traced shadow union grown by
+  ``tol + grid``.  ``inner`` is inside E *as long as the sweep misses no shadow
+  deeper than tol* (docs/DESIGN.md, "What is and is not guaranteed": not proven;
+  checked empirically, ``tests/geometry/test_swept_bounds.py``).
+* ``outer`` is ``allowed`` minus the union of the *sampled* stationary shadows S(q_k)
+  (q_k on the boundary of G, so in G).  Each S(q_k) is an exact stationary shadow, so
+  it is a subset of the exact union and ``E ⊆ outer``.  This needs no claim about the
+  tracing between samples: it is proven given the stationary shadow (paper 3.2.1), up
+  to the snap-rounding of the shadows' overlays (boundaries move by less than the
+  ~1e-12 D grid; a lit sliver narrower than it collapses into the shadow).
+  For a non-star-shaped target with overlap strips (the certified stand-in of
+  :mod:`geometry.nonstar`) the stand-in's shadows are not subsets of the exact ones;
+  there the sampled shadows are the real outline's whole-outline stationary shadows
+  (blind to the whole outline implies blind to its wanted part).
+
+See docs/DESIGN.md, "Certified swept answers".
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+import shapely
+
+from ._common import (
+    Budget,
+    as_scene,
+    check_aim,
+    check_eps_pos,
+    check_theta,
+    check_tol,
+    polygonal,
+    shrink_for_position,
+)
+from ._frame import world_messages
+from ._shapes import ccw_ring, union_all
+from .mixed import _point_side, point_strips
+from .partial import _partial_region, _swept_region, swept_tol
+from .recognize import _accuracy, overlap_strips
+from .sweep import QueryTimeout
+
+if TYPE_CHECKING:  # pragma: no cover
+    from .scene import Scene
+
+__all__ = ["SweptBounds", "hausdorff_bounds", "swept_bounds"]
+
+#: The Hausdorff distance is bounded on cells refined from a grid of this many along the
+#: longer side of the gap's bounding box (:func:`hausdorff_bounds`) ...
+HAUSDORFF_CELLS = 64
+#: ... until the upper and lower bounds agree to this fraction of the upper one.
+HAUSDORFF_REL = 0.05
+
+
+@dataclass(frozen=True)
+class SweptBounds:
+    """Inner and outer bound of a swept query's exact answer E: ``inner ⊆ E ⊆ outer``.
+
+    Attributes
+    ----------
+    inner : the placements certified to see (shapely Polygon/MultiPolygon, world frame):
+        the query's ``conservative=True`` answer.
+    outer : every placement of E is in it (world frame); outside it a sampled
+        configuration of the target blinds the placement.
+    hausdorff : an upper bound on the Hausdorff distance between ``inner`` and
+        ``outer`` (scene units), within ``hausdorff - hausdorff_lower`` of the true
+        value; ``inf`` when ``inner`` is empty and ``outer`` is not.
+    hausdorff_lower : a lower bound on it (scene units).
+    samples : how many exact stationary shadows make up the outer bound.
+    """
+
+    inner: shapely.Geometry
+    outer: shapely.Geometry
+    hausdorff: float
+    hausdorff_lower: float
+    samples: int
+
+
+def swept_bounds(
+    scene: Scene,
+    *,
+    target_in: str | shapely.Geometry | None = None,
+    recognizable: bool = False,
+    theta: float = 0.0,
+    eps_pos: float = 0.0,
+    eps_aim: float = 0.0,
+    tol: float | None = None,
+    timeout: float | None = None,
+    progress: Callable[[int, int], None] | None = None,
+    densify: int = 0,
+) -> SweptBounds:
+    """Inner and outer bound of a swept query (see the module docstring).
+
+    Parameters
+    ----------
+    target_in : the swept partial region ``partial_region(scene, target_in=...)``:
+        ``"goal"``, ``"failure"`` or a shapely Polygon/Point (world frame).
+    recognizable : instead, ``recognizable_region(scene, model="partial", theta=...)``
+        of a scene whose G or H is a polygon (paper 5.2, mixed point/polygon).
+    theta, eps_pos, eps_aim, tol, timeout, progress : as in those queries.
+    densify : extra exact stationary shadows per edge of G's (H's) boundary, evenly
+        spaced, for the outer bound only (tighter, one stationary query each).
+
+    Returns
+    -------
+    :class:`SweptBounds` in world coordinates (scene units); ``inner`` equals the
+    query's ``conservative=True`` answer.
+    """
+    scene = as_scene(scene)
+    if (target_in is None) == (not recognizable):
+        raise ValueError("give exactly one of target_in=<region> or recognizable=True")
+    theta = check_theta(theta)
+    if theta is None:
+        raise NotImplementedError("swept_bounds needs a fixed orientation theta")
+    eps_pos = check_eps_pos(scene, eps_pos)
+    eps_aim = check_aim(eps_aim)
+    tol = check_tol(tol)
+    what = "swept_bounds(recognizable=True)" if recognizable else "swept_bounds(target_in=...)"
+    budget = Budget.make(timeout, progress, what)
+    fr = scene.frame
+    with world_messages(fr):
+        local = scene.local
+        if isinstance(densify, bool) or not isinstance(densify, int) or densify < 0:
+            raise ValueError(f"densify must be an int >= 0, got {densify!r}")
+        args = (
+            float(theta), fr.length(eps_pos), eps_aim, swept_tol(local, fr.length(tol)), budget,
+            densify,
+        )  # fmt: skip
+        if recognizable:
+            inner, outer, n = _recognizable_bounds(local, *args)
+        else:
+            inner, outer, n = _side(local, fr.region(target_in), *args)
+    inner, outer = fr.to_world(inner), fr.to_world(outer)
+    hi, lo = hausdorff_bounds(inner, outer)
+    return SweptBounds(inner, outer, hi, lo, n)
+
+
+def _side(
+    scene: Scene,
+    target_in: str | shapely.Geometry,
+    theta: float,
+    eps_pos: float,
+    eps_aim: float,
+    tol: float,
+    budget: Budget,
+    densify: int = 0,
+    strips: list[shapely.Geometry] | None = None,
+) -> tuple[shapely.Geometry, shapely.Geometry, int]:
+    """(inner, outer, number of sampled shadows) of one swept partial region, local frame."""
+    sink: dict = {}
+    inner = _swept_region(
+        scene, target_in, theta, eps_pos, eps_aim, tol, True, strips=strips, budget=budget,
+        sink=sink, extra_samples=densify,
+    )  # fmt: skip
+    samples = sink["samples"]
+    stand_in = sink["stand_in"]
+    if stand_in is not None and not stand_in.exact:
+        # the hull stand-in's shadows are not inside the real ones: use the real outline's
+        # whole-outline stationary shadows (blind to all of A_q => blind to its wanted part)
+        shadows = []
+        for q, _ in samples:
+            if budget.deadline is not None and time.monotonic() > budget.deadline:
+                raise QueryTimeout(
+                    f"{budget.what} ran past its timeout while computing the outer bound's "
+                    f"shadows ({len(samples) - len(shadows)} of {len(samples)} left); raise "
+                    "timeout= or give timeout=None"
+                )
+            shadows.append(_whole_shadow(scene, q, theta, eps_aim))
+    else:
+        shadows = [s for _, s in samples]
+    grid = sink["grid"]
+    union = union_all(shadows, grid_size=grid) if shadows else shapely.Polygon()
+    allowed = sink["allowed"]
+    outer = polygonal(shapely.difference(allowed, union))
+    if eps_pos > 0:
+        # shrink_for_position grows by a circumscribed polygon of radius r + 2 delta
+        # (delta = 1e-9 * diag): keep that inside the eps disc, so outer stays outside E
+        delta = 1e-9 * max(_diag(allowed), 1.0)
+        r = eps_pos * math.cos(math.pi / 64) * (1 - 1e-9) - 2 * delta
+        if r > 0:
+            outer = shrink_for_position(outer, allowed, r)
+    return inner, outer, len(shadows)
+
+
+def _whole_shadow(scene: Scene, q: np.ndarray, theta: float, eps_aim: float) -> shapely.Geometry:
+    """The real target's stationary shadow at ``q`` (whole outline wanted), local frame."""
+    pose = (float(q[0]), float(q[1]), theta)
+    seen = _partial_region(scene, pose, None, theta, 0.0, eps_aim, None, False)
+    area = scene.target_at(*pose)
+    return polygonal(shapely.difference(shapely.difference(scene.free_space, area), seen))
+
+
+def _recognizable_bounds(
+    scene: Scene,
+    theta: float,
+    eps_pos: float,
+    eps_aim: float,
+    tol: float,
+    budget: Budget,
+    densify: int,
+) -> tuple[shapely.Geometry, shapely.Geometry, int]:
+    """(inner, outer, samples) of the partial-model recognizable region, local frame."""
+    g, h = scene.goal_geom, scene.failure_geom
+    if g.geom_type == "Point" and h.geom_type == "Point":
+        raise ValueError(
+            "swept_bounds(recognizable=True) needs a polygonal goal or failure region: with "
+            "two points the recognizable region is stationary (exact, nothing to bound)"
+        )
+    target = ccw_ring(scene.target_at(0.0, 0.0, theta))
+    acc = _accuracy(scene)
+    if g.geom_type != h.geom_type:  # geometry/mixed.py
+        names = ("goal", "failure")
+        pt_name = next(w for w in names if scene.region(w).geom_type == "Point")
+        poly_name = next(w for w in names if w != pt_name)
+        point, poly = scene.region(pt_name), scene.region(poly_name)
+        inner, outer, n = _side(
+            scene, poly_name, theta, eps_pos, eps_aim, tol, budget, densify,
+            strips=point_strips(target, point, *acc),
+        )  # fmt: skip
+        vs_poly = overlap_strips(target, poly, *acc)
+        still = _point_side(scene, point, theta, vs_poly, eps_pos, eps_aim)
+        return (
+            polygonal(shapely.intersection(inner, still)),
+            polygonal(shapely.intersection(outer, still)),
+            n,
+        )
+    n_g, n_h = (
+        len(shapely.get_coordinates(scene.region(w).boundary)) - 1 for w in ("goal", "failure")
+    )
+    sides = [
+        _side(
+            scene, me, theta, eps_pos, eps_aim, tol,
+            dataclasses.replace(budget, offset=off, total=n_g + n_h), densify,
+            strips=overlap_strips(target, scene.region(other), *acc),
+        )  # fmt: skip
+        for (me, other), off in ((("goal", "failure"), 0), (("failure", "goal"), n_g))
+    ]
+    return (
+        polygonal(shapely.intersection(sides[0][0], sides[1][0])),
+        polygonal(shapely.intersection(sides[0][1], sides[1][1])),
+        sides[0][2] + sides[1][2],
+    )
+
+
+def hausdorff_bounds(
+    inner: shapely.Geometry,
+    outer: shapely.Geometry,
+    rel: float = HAUSDORFF_REL,
+    max_cells: int = 200_000,
+) -> tuple[float, float]:
+    """(upper, lower) bounds on sup_{x in outer} dist(x, inner), the Hausdorff distance
+    of ``inner ⊆ outer`` (same units as the input).
+
+    The distance to ``inner`` is 1-Lipschitz.  Square cells (centre c, half-diagonal r)
+    cover the gap ``outer - inner``; a cell whose centre is farther than r from the gap
+    holds none of it, and the others bound the distance in them by dist(c, inner) + r
+    (upper).  Centres inside the gap and densified vertices of the gap give the lower
+    bound.  Cells that cannot beat the lower bound are dropped, the rest split in four,
+    until upper - lower <= ``rel`` * upper (or ``max_cells``, or 12 levels).  ``(inf,
+    inf)`` when ``inner`` is empty and ``outer`` is not."""
+    gap = polygonal(shapely.difference(outer, inner))
+    if gap.is_empty or gap.area == 0.0:
+        return 0.0, 0.0
+    if inner.is_empty:
+        return math.inf, math.inf
+    x0, y0, x1, y1 = gap.bounds
+    h = max(x1 - x0, y1 - y0) / HAUSDORFF_CELLS
+    xs = np.arange(x0 + h / 2, x1 + h, h)
+    ys = np.arange(y0 + h / 2, y1 + h, h)
+    c = np.column_stack([a.ravel() for a in np.meshgrid(xs, ys)])
+    verts = shapely.get_coordinates(shapely.segmentize(gap, h / 4))
+    lower = float(_dist(inner, verts).max(initial=0.0))
+    upper = math.inf
+    for _ in range(12):
+        r = h / math.sqrt(2.0)
+        dg = _dist(gap, c)
+        c, dg = c[dg <= r], dg[dg <= r]
+        di = _dist(inner, c)
+        lower = max(lower, float(di[dg == 0.0].max(initial=0.0)))
+        bound = di + r
+        upper = max(lower, float(bound.max(initial=0.0)))
+        if upper - lower <= rel * upper or 4 * len(c) > max_cells:
+            break
+        c = c[bound > lower]
+        h /= 2
+        q = h / 2
+        c = (c[:, None, :] + np.array([[-q, -q], [q, -q], [-q, q], [q, q]])[None]).reshape(-1, 2)
+    return upper, lower
+
+
+def _dist(region: shapely.Geometry, pts: np.ndarray) -> np.ndarray:
+    """Distance from each point (n, 2) to the polygonal ``region`` (0 inside), indexed."""
+    if len(pts) == 0:
+        return np.zeros(0)
+    rings = [r for p in shapely.get_parts(region) for r in (p.exterior, *p.interiors)]
+    coords = [np.asarray(r.coords)[:, :2] for r in rings]
+    segs = shapely.linestrings(
+        np.concatenate([np.stack([c[:-1], c[1:]], axis=1) for c in coords])
+    )
+    tree = shapely.STRtree(segs)
+    points = shapely.points(pts)
+    (_, _), d = tree.query_nearest(points, return_distance=True, all_matches=False)
+    shapely.prepare(region)
+    inside = shapely.contains_xy(region, pts[:, 0], pts[:, 1])
+    return np.where(inside, 0.0, d)
+
+
+def _diag(g: shapely.Geometry) -> float:
+    x0, y0, x1, y1 = g.bounds
+    return math.hypot(x1 - x0, y1 - y0)

@@ -1,0 +1,310 @@
+"""Certified swept answers (issue 25 item 2): ``geometry.swept_bounds``.
+
+Truth is an independent dense brute force: V(p) from CGAL (pyvispoly, tests/oracle.py)
+and the target placed at configurations q sampled densely on the boundary of G and
+inside it.  A placement *passes* when V(p) meets A_q for every sampled q; a sampled q
+whose A_q misses V(p) is a witness that p is blinded.  On fuzzed, generated and
+bundled scenes:
+
+* every placement of ``inner`` (farther than 1e-7 D from its boundary) passes;
+* every placement of the allowed space outside ``outer`` (farther than 1e-7 D from
+  it) has a witness;
+* ``inner ⊆ outer`` and ``inner`` is the ``conservative=True`` answer.
+
+The checker is shown to fail on a deliberately wrong outer (the default answer
+eroded) and a deliberately wrong inner (the default answer grown).
+"""
+
+from __future__ import annotations
+
+import zlib
+
+import numpy as np
+import pytest
+
+pytest.importorskip("pyvispoly")
+
+import shapely  # noqa: E402
+
+from geometry import Scene, partial_region, recognizable_region, swept_bounds  # noqa: E402
+from geometry.fuzz import fuzz_scene  # noqa: E402
+from geometry.generate import random_scene  # noqa: E402
+
+try:
+    from tests.oracle import VisOracle
+except ImportError:  # pragma: no cover
+    from oracle import VisOracle
+
+MARGIN = 1e-7  # of the diameter: closer to a boundary, rounding decides
+
+
+def _generated(seed: int) -> Scene:
+    rng = np.random.default_rng(500 + seed)
+    while True:
+        d = random_scene(rng, goal="polygon", n_obstacles=int(rng.integers(4, 9)))
+        try:
+            return Scene.from_dict(d)
+        except Exception:  # pragma: no cover - redraw
+            continue
+
+
+def _fuzzed(seed: int) -> Scene:
+    d = fuzz_scene(seed, nonstar=True)
+    assert d is not None
+    return Scene.from_dict({k: v for k, v in d.items() if k != "features"})
+
+
+SCENES = {
+    "fuzz-8-star": lambda: _fuzzed(8),
+    "fuzz-1-nonstar": lambda: _fuzzed(1),
+    "fuzz-22-nonstar": lambda: _fuzzed(22),
+    "generated-2": lambda: _generated(2),
+    "generated-3": lambda: _generated(3),
+    "bundled-lab": lambda: Scene.load("sensorplan_gym/scenes/lab.json"),
+}
+
+
+def _configs(g: shapely.Polygon, rng: np.random.Generator, per_edge: int = 120, inner: int = 40):
+    c = np.asarray(g.exterior.coords)
+    t = np.linspace(0.0, 1.0, per_edge, endpoint=False)
+    bnd = np.vstack([a + t[:, None] * (b - a) for a, b in zip(c[:-1], c[1:], strict=True)])
+    x0, y0, x1, y1 = g.bounds
+    pts = rng.uniform((x0, y0), (x1, y1), (20 * inner, 2))
+    pts = pts[shapely.contains_xy(g, pts[:, 0], pts[:, 1])][:inner]
+    return np.vstack([bnd, pts])
+
+
+def _placements(allowed, near, rng: np.random.Generator, n: int) -> np.ndarray:
+    """n uniform placements in ``allowed`` and n in ``near`` (the boundaries' band)."""
+    out = []
+    for geom in (allowed, near):
+        x0, y0, x1, y1 = geom.bounds
+        got: list = []
+        shapely.prepare(geom)
+        while len(got) < n:
+            cand = rng.uniform((x0, y0), (x1, y1), (4 * n, 2))
+            got.extend(cand[shapely.contains_xy(geom, cand[:, 0], cand[:, 1])])
+        out.append(np.asarray(got[:n]))
+    return np.vstack(out)
+
+
+def _truth(scene: Scene, pts: np.ndarray, theta: float, rng: np.random.Generator) -> np.ndarray:
+    """Per placement: does it see some of A_q at every sampled q in G (dense brute force)?"""
+    qs = _configs(scene.goal_geom, rng)
+    a = scene.target_at(0.0, 0.0, theta)
+    targets = np.asarray([shapely.affinity.translate(a, x, y) for x, y in qs])
+    oracle = VisOracle(scene)
+    ok = np.zeros(len(pts), dtype=bool)
+    for k, p in enumerate(pts):
+        vis = oracle.visibility(p)
+        if vis.is_empty:
+            continue
+        shapely.prepare(vis)
+        ok[k] = bool(shapely.intersects(vis, targets).all())
+    return ok
+
+
+def _violations(scene, inner, outer, pts, passes) -> tuple[list, list]:
+    """(inner placements that fail, placements outside outer that pass), away from the
+    boundaries by MARGIN * D."""
+    m = MARGIN * scene.diameter
+    pp = shapely.points(pts)
+    far = np.full(len(pts), np.inf)
+    d_in = shapely.distance(inner.boundary, pp) if not inner.is_empty else far
+    d_out = shapely.distance(outer.boundary, pp) if not outer.is_empty else far
+    in_inner = shapely.contains_xy(inner, pts[:, 0], pts[:, 1])
+    in_outer = shapely.contains_xy(outer, pts[:, 0], pts[:, 1])
+    bad_inner = [
+        tuple(p) for p, i, d, ok in zip(pts, in_inner, d_in, passes) if i and d > m and not ok
+    ]
+    bad_outer = [
+        tuple(p) for p, o, d, ok in zip(pts, in_outer, d_out, passes) if not o and d > m and ok
+    ]
+    return bad_inner, bad_outer
+
+
+def _setup(name: str, n: int = 120):
+    scene = SCENES[name]()
+    b = swept_bounds(scene, target_in="goal")
+    D = scene.diameter
+    default = partial_region(scene, target_in="goal")
+    swept_area = shapely.union_all(
+        [shapely.affinity.translate(scene.target_at(0, 0, 0.0), x, y)
+         for x, y in np.asarray(scene.goal_geom.exterior.coords)]
+        + [scene.goal_geom]
+    )  # fmt: skip
+    space = shapely.difference(scene.free_space, shapely.buffer(swept_area, 1e-6 * D))
+    space = shapely.difference(space, shapely.convex_hull(swept_area).buffer(1e-6 * D))
+    near = shapely.intersection(
+        space, shapely.buffer(shapely.union(b.inner.boundary, b.outer.boundary), 5e-3 * D)
+    )
+    rng = np.random.default_rng(zlib.crc32(name.encode()))
+    pts = _placements(space, near, rng, n)
+    passes = _truth(scene, pts, 0.0, rng)
+    return scene, b, default, pts, passes
+
+
+@pytest.mark.parametrize("name", list(SCENES))
+def test_bounds_hold_against_dense_brute_force(name):
+    scene, b, default, pts, passes = _setup(name)
+    D = scene.diameter
+    cons = partial_region(scene, target_in="goal", conservative=True)
+    assert shapely.symmetric_difference(b.inner, cons).area <= 1e-12 * D * D
+    assert shapely.difference(b.inner, b.outer).area <= 1e-12 * D * D
+    assert shapely.difference(default, b.outer).area <= 1e-12 * D * D
+    assert b.samples > 0 and b.hausdorff >= b.hausdorff_lower >= 0
+    bad_inner, bad_outer = _violations(scene, b.inner, b.outer, pts, passes)
+    assert not bad_inner, f"{name}: inner placements blinded by a sampled q: {bad_inner[:5]}"
+    assert not bad_outer, f"{name}: placements outside outer that see at every q: {bad_outer[:5]}"
+    # not vacuous: both kinds of placement were checked
+    in_inner = shapely.contains_xy(b.inner, pts[:, 0], pts[:, 1])
+    out_outer = ~shapely.contains_xy(b.outer, pts[:, 0], pts[:, 1])
+    assert in_inner.sum() >= 50 and out_outer.sum() >= 10, (in_inner.sum(), out_outer.sum())
+    print(
+        f"{name}: hausdorff <= {b.hausdorff / D:.2e} D ({b.hausdorff / (1e-4 * D):.0f} tol), "
+        f">= {b.hausdorff_lower / D:.2e} D; gap area {(b.outer.area - b.inner.area) / D**2:.2e} D^2"
+    )
+
+
+def test_the_check_fails_on_wrong_bounds():
+    scene, b, default, pts, passes = _setup("generated-2")
+    D = scene.diameter
+    wrong_outer = shapely.buffer(default, -1e-2 * D)  # the default answer eroded
+    _, bad_outer = _violations(scene, b.inner, wrong_outer, pts, passes)
+    assert bad_outer, "an eroded outer went unnoticed"
+    wrong_inner = shapely.intersection(shapely.buffer(default, 2e-2 * D), b.outer.envelope)
+    bad_inner, _ = _violations(scene, wrong_inner, b.outer, pts, passes)
+    assert bad_inner, "a grown inner went unnoticed"
+
+
+RECOGNIZABLE = {
+    "warehouse": lambda: Scene.load("sensorplan_gym/scenes/warehouse.json"),
+    "fuzz-1-nonstar": lambda: _fuzzed(1),  # hull stand-in: whole-outline outer shadows
+    "fuzz-22-mixed-nonstar": lambda: _fuzzed(22),  # a point and a polygon
+}
+
+
+@pytest.mark.parametrize("name", list(RECOGNIZABLE))
+def test_recognizable_bounds_bracket_the_answers(name):
+    """5.2 (polygonal or mixed G and H): inner is the conservative answer, and both the
+    default and the conservative answers lie inside outer."""
+    scene = RECOGNIZABLE[name]()
+    D = scene.diameter
+    b = swept_bounds(scene, recognizable=True)
+    cons = recognizable_region(scene, model="partial", theta=0.0, conservative=True)
+    default = recognizable_region(scene, model="partial", theta=0.0)
+    assert shapely.symmetric_difference(b.inner, cons).area <= 1e-12 * D * D
+    assert shapely.difference(default, b.outer).area <= 1e-12 * D * D
+    assert shapely.difference(b.inner, b.outer).area <= 1e-12 * D * D
+
+
+def test_bad_arguments_name_the_problem():
+    scene = SCENES["bundled-lab"]()
+    with pytest.raises(ValueError, match="exactly one"):
+        swept_bounds(scene)
+    with pytest.raises(ValueError, match="densify"):
+        swept_bounds(scene, target_in="goal", densify=-1)
+
+
+# ---- paper 5.2: polygonal G and H, wanted pieces built independently -------------------------
+
+
+def _truth_recognizable(scene: Scene, pts: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    """Per placement: for every sampled configuration q in G (in H), does it see a wanted
+    point of A_q (the outline minus the overlaps with the target anywhere in H (in G))?
+    Convex target: a wanted piece is seen when V(p) meets it on a front-facing edge."""
+    from tests.geometry.test_swept_partial import _wanted
+
+    oracle = VisOracle(scene)
+    groups = []
+    for me, other in ((scene.goal_geom, scene.failure_geom), (scene.failure_geom, scene.goal_geom)):
+        qs = _configs(me, rng, per_edge=40, inner=15)
+        rows = [
+            (seg, nrm, a0, j)
+            for j, q in enumerate(qs)
+            for seg, nrm, a0 in _wanted(scene, q, other, 0.0)
+        ]
+        segs, nrms, anchors, owner = (np.asarray(x) for x in zip(*rows, strict=True))
+        groups.append((segs, nrms, anchors, owner.astype(int), len(qs)))
+    ok = np.ones(len(pts), dtype=bool)
+    for k, p in enumerate(pts):
+        vis = oracle.visibility(p)
+        if vis.is_empty:
+            ok[k] = False
+            continue
+        shapely.prepare(vis)
+        for segs, nrms, anchors, owner, n_q in groups:
+            front = ((p - anchors) * nrms).sum(axis=1) > 0
+            seen = np.zeros(len(segs), dtype=bool)
+            lengths = shapely.length(shapely.intersection(vis, segs[front]))
+            seen[front] = lengths > 1e-9 * scene.diameter
+            ok[k] &= bool(np.bincount(owner[seen], minlength=n_q).astype(bool).all())
+    return ok
+
+
+@pytest.mark.parametrize("seed", [21])
+def test_recognizable_bounds_hold_against_brute_force(seed):
+    from tests.geometry.test_swept_partial import _scene
+
+    scene = _scene(seed, convex_target=True)
+    D = scene.diameter
+    b = swept_bounds(scene, recognizable=True)
+    cons = recognizable_region(scene, model="partial", theta=0.0, conservative=True)
+    assert shapely.symmetric_difference(b.inner, cons).area <= 1e-12 * D * D
+    assert shapely.difference(b.inner, b.outer).area <= 1e-12 * D * D
+    areas = [
+        shapely.affinity.translate(scene.target_at(0, 0, 0.0), x, y)
+        for g in (scene.goal_geom, scene.failure_geom)
+        for x, y in np.asarray(g.exterior.coords)
+    ]
+    hull = shapely.union_all(
+        [shapely.convex_hull(shapely.union_all(areas[: len(areas) // 2])),
+         shapely.convex_hull(shapely.union_all(areas[len(areas) // 2 :]))]
+    )  # fmt: skip
+    space = shapely.difference(scene.free_space, shapely.buffer(hull, 1e-6 * D))
+    near = shapely.intersection(
+        space, shapely.buffer(shapely.union(b.inner.boundary, b.outer.boundary), 5e-3 * D)
+    )
+    rng = np.random.default_rng(seed)
+    pts = _placements(space, near, rng, 100)
+    passes = _truth_recognizable(scene, pts, rng)
+    bad_inner, bad_outer = _violations(scene, b.inner, b.outer, pts, passes)
+    assert not bad_inner, f"5.2 seed {seed}: inner placements that fail: {bad_inner[:5]}"
+    assert not bad_outer, f"5.2 seed {seed}: placements outside outer that pass: {bad_outer[:5]}"
+    assert (~passes).sum() >= 10 and passes.sum() >= 10
+    print(
+        f"5.2 seed {seed}: hausdorff <= {b.hausdorff / D:.2e} D, gap area "
+        f"{(b.outer.area - b.inner.area) / D**2:.2e} D^2"
+    )
+
+
+def test_uncertainty_and_densify_keep_the_bracket():
+    """eps_pos / eps_aim: inner is the conservative answer and inside outer, the default
+    answer inside outer; densify adds exact shadows, so outer can only shrink."""
+    scene = SCENES["fuzz-8-star"]()
+    D = scene.diameter
+    kw = dict(target_in="goal", eps_pos=0.01 * D, eps_aim=0.01)
+    b = swept_bounds(scene, **kw)
+    cons = partial_region(scene, conservative=True, **kw)
+    default = partial_region(scene, **kw)
+    assert shapely.symmetric_difference(b.inner, cons).area <= 1e-12 * D * D
+    assert shapely.difference(b.inner, b.outer).area <= 1e-12 * D * D
+    assert shapely.difference(default, b.outer).area <= 1e-12 * D * D
+    plain = swept_bounds(scene, target_in="goal")
+    dense = swept_bounds(scene, target_in="goal", densify=2)
+    assert dense.samples > plain.samples
+    assert shapely.difference(dense.outer, plain.outer).area <= 1e-12 * D * D
+    assert shapely.difference(dense.inner, dense.outer).area <= 1e-12 * D * D
+
+
+def test_hausdorff_bounds_bracket_a_known_distance():
+    """A box against its frame of width 1: the farthest point (the centre) is 4 from the
+    frame, and GEOS's discrete distance (1.0, vertices to boundaries) would miss it."""
+    from geometry.certify import hausdorff_bounds
+
+    box = shapely.box(0, 0, 10, 10)
+    frame = box.difference(shapely.box(1, 1, 9, 9))
+    hi, lo = hausdorff_bounds(frame, box)
+    assert lo <= 4.0 <= hi and hi - lo <= 0.06 * hi
+    assert hausdorff_bounds(box, box) == (0.0, 0.0)
+    assert hausdorff_bounds(shapely.Polygon(), box) == (float("inf"), float("inf"))
