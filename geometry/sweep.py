@@ -252,11 +252,19 @@ class Sweeper:
         key a pair of anchor ids spanning the line (shadow on the edge's left)."""
         out = []
         n = self.n_fixed
-        for ring in _rings(shapely.orient_polygons(shadow, exterior_cw=False)):
-            v = _drop_short(np.asarray(ring.coords)[:-1, :2], self.tol_lab)
-            if len(v) < 3:
-                continue
-            keys = self._label(v, table, tid)
+        vs = [
+            v
+            for ring in _rings(shapely.orient_polygons(shadow, exterior_cw=False))
+            if len(v := _drop_short(np.asarray(ring.coords)[:-1, :2], self.tol_lab)) >= 3
+        ]
+        if not vs:
+            return out
+        # all rings labelled in one batch (row by row, so as if ring by ring)
+        d = np.concatenate([np.roll(v, -1, axis=0) - v for v in vs])
+        all_keys = self._label(np.concatenate(vs), table, tid, d=d)
+        off = np.cumsum([0] + [len(v) for v in vs])
+        for r, v in enumerate(vs):
+            keys = all_keys[off[r] : off[r + 1]]
             moving = (keys >= n).any(axis=1) & (keys >= 0).all(axis=1)
             for i in np.flatnonzero(moving):
                 kp, kn = keys[i - 1], keys[(i + 1) % len(v)]
@@ -265,9 +273,14 @@ class Sweeper:
                 out.append((tuple(kp), tuple(keys[i]), tuple(kn)))
         return out
 
-    def _label(self, v: np.ndarray, table: np.ndarray, tid: np.ndarray) -> np.ndarray:
-        """Per edge of the closed ring ``v``: two anchor ids spanning its line, or -1."""
-        d = np.roll(v, -1, axis=0) - v
+    def _label(
+        self, v: np.ndarray, table: np.ndarray, tid: np.ndarray, d: np.ndarray | None = None
+    ) -> np.ndarray:
+        """Per edge of the closed ring ``v``: two anchor ids spanning its line, or -1.
+        ``d``: the edge vectors (default: of the closed ring ``v``; given, the rows are
+        edges ``v[i] -> v[i] + d[i]`` of any rings)."""
+        if d is None:
+            d = np.roll(v, -1, axis=0) - v
         ln = np.hypot(d[:, 0], d[:, 1])
         dist = np.abs(_cross(d[:, None, :], table[None, :, :] - v[:, None, :])) / np.maximum(
             ln[:, None], 1e-300
@@ -283,9 +296,14 @@ class Sweeper:
         on = on[rows]
         tab = table[perm]
         a = np.argmax(on, axis=1)
-        far = on & (np.abs(tab[None, :, :] - tab[a][:, None, :]).max(axis=2) > self.tol_lab)
-        ok = far.any(axis=1)
-        b = np.argmax(far, axis=1)
+        # the candidates are few per row: test "away from the first" on them only
+        r_on, c_on = np.nonzero(on)  # row-major: by row, then in perm order
+        far = np.abs(tab[c_on] - tab[a[r_on]]).max(axis=1) > self.tol_lab
+        r_far, first = np.unique(r_on[far], return_index=True)
+        ok = np.zeros(len(rows), dtype=bool)
+        ok[r_far] = True
+        b = np.zeros(len(rows), dtype=np.int64)
+        b[r_far] = c_on[far][first]
         ids = tid[perm]
         pair = np.sort(np.stack([ids[a], ids[b]], axis=1), axis=1)
         keys[rows[ok]] = pair[ok]
@@ -905,33 +923,44 @@ class Sweeper:
 
     def _valid_many(self, vs: np.ndarray, ve: np.ndarray, ts: np.ndarray, q0, dq) -> np.ndarray:
         """(E, T) bool: the traced edge is a shadow edge at that time (exact point
-        test on probes just inside the shadow along the edge)."""
+        test on probes just inside the shadow along the edge).
+
+        The probes are tested in two rounds: the ends and the fixed fractions first,
+        then the probes between the crossings of :meth:`_between_lines` (hundreds per
+        edge on maps of a few hundred edges) only where the first round found every
+        probe blind.  An edge is valid iff all its probes are blind, so the answer is
+        the same as testing them all at once."""
         d = ve - vs
         ln = np.hypot(d[..., 0], d[..., 1])
         with np.errstate(divide="ignore", invalid="ignore"):
             u = d / ln[..., None]
         h = np.minimum(self.h, 0.05 * ln)[..., None]
         nrm = _rot(u) * (1e-3 * h)
-        fr = np.broadcast_to(np.arange(1, self.probes) / self.probes, ln.shape + (self.probes - 1,))
-        fr = np.concatenate([fr, self._between_lines(vs, d, ts, q0, dq)], axis=-1)
         edge_h = (h[..., 0] / np.where(ln > 0, ln, 1.0))[..., None]
-        fr = np.clip(np.where(np.isfinite(fr), fr, 0.5), edge_h, 1 - edge_h)  # ends: probed above
-        probes = [vs + h * u + nrm, ve - h * u + nrm]
-        probes = np.concatenate(
-            [np.stack(probes, axis=-2), vs[..., None, :] + fr[..., None] * d[..., None, :]], axis=-2
-        ) + np.concatenate(
-            [
-                np.zeros_like(nrm)[..., None, :].repeat(2, -2),
-                nrm[..., None, :].repeat(fr.shape[-1], -2),
-            ],
-            axis=-2,
-        )  # (E, T, P, 2)
-        q = np.broadcast_to((q0 + ts[..., None] * dq)[..., None, :], probes.shape)
-        flat_p, flat_q = probes.reshape(-1, 2), q.reshape(-1, 2)
+        q = q0 + ts[..., None] * dq  # (E, T, 2)
+        fr = np.broadcast_to(np.arange(1, self.probes) / self.probes, ln.shape + (self.probes - 1,))
+        fr = np.clip(fr, edge_h, 1 - edge_h)  # ends: probed below
+        ends = np.stack([vs + h * u + nrm, ve - h * u + nrm], axis=-2)
+        inner = vs[..., None, :] + fr[..., None] * d[..., None, :] + nrm[..., None, :]
+        ok = self._probes_blind(np.concatenate([ends, inner], axis=-2), q) & (ln > 0)
+        if ok.any():
+            vs2, d2, q2 = vs[ok][:, None], d[ok][:, None], q[ok][:, None]
+            fb = self._between_lines(vs2, d2, np.asarray(ts)[ok][:, None], q0, dq)
+            eh = edge_h[ok][:, None]
+            fb = np.clip(np.where(np.isfinite(fb), fb, 0.5), eh, 1 - eh)
+            more = vs2[..., None, :] + fb[..., None] * d2[..., None, :] + nrm[ok][:, None, None, :]
+            ok[ok] = self._probes_blind(more, q2)[:, 0]
+        return ok
+
+    def _probes_blind(self, probes: np.ndarray, q: np.ndarray) -> np.ndarray:
+        """(...) bool: every probe ``probes`` (..., P, 2) is blind to the target at
+        ``q`` (..., 2) (a probe that is not finite is not blind)."""
+        qq = np.broadcast_to(q[..., None, :], probes.shape)
+        flat_p, flat_q = probes.reshape(-1, 2), qq.reshape(-1, 2)
         finite = np.isfinite(flat_p).all(axis=1)
         res = np.zeros(len(flat_p), dtype=bool)
         res[finite] = self.blind(flat_p[finite], flat_q[finite])
-        return res.reshape(probes.shape[:-1]).all(axis=-1) & (ln > 0)
+        return res.reshape(probes.shape[:-1]).all(axis=-1)
 
 
 def _tangent(w: np.ndarray, bp: np.ndarray, bn: np.ndarray, rel: float = 1e-9) -> np.ndarray:
@@ -1003,10 +1032,16 @@ def _drop_short(v: np.ndarray, length: float) -> np.ndarray:
     (snap-rounding nodes a corner at a hot pixel, floating overlay leaves ulp-sized
     edges), and its line is not determined to within ``length``, so it cannot be
     labelled and would hide its neighbours from the tracing."""
-    keep = [0]
-    for i in range(1, len(v)):
-        if np.abs(v[i] - v[keep[-1]]).max() >= length:
-            keep.append(i)
+    if len(v) == 0:
+        return v
+    step = np.abs(np.diff(v, axis=0)).max(axis=1) >= length
+    if step.all():  # no short edge inside: every vertex is kept (the loop below agrees)
+        keep = list(range(len(v)))
+    else:
+        keep = [0]
+        for i in range(1, len(v)):
+            if np.abs(v[i] - v[keep[-1]]).max() >= length:
+                keep.append(i)
     while len(keep) > 1 and np.abs(v[keep[-1]] - v[0]).max() < length:
         keep.pop()
     return v[keep]

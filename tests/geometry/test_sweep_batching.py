@@ -1,0 +1,97 @@
+"""The batched helpers of :class:`geometry.sweep.Sweeper` agree with their one-at-a-time
+definitions (issue 25 item 1: speed without changing answers)."""
+
+from __future__ import annotations
+
+import numpy as np
+import shapely
+
+from geometry import Scene, partial_region
+from geometry import sweep as S
+
+
+def _drop_short_loop(v: np.ndarray, length: float) -> np.ndarray:
+    keep = [0]
+    for i in range(1, len(v)):
+        if np.abs(v[i] - v[keep[-1]]).max() >= length:
+            keep.append(i)
+    while len(keep) > 1 and np.abs(v[keep[-1]] - v[0]).max() < length:
+        keep.pop()
+    return v[keep]
+
+
+def test_drop_short_matches_the_loop() -> None:
+    rng = np.random.default_rng(7)
+    for _ in range(200):
+        v = np.cumsum(rng.normal(size=(12, 2)), axis=0)
+        k = rng.integers(0, 4)
+        for i in rng.integers(0, len(v), size=k):  # short edges, incl. the closing one
+            v[i] = v[i - 1] + 1e-9
+        assert np.array_equal(S._drop_short(v, 1e-6), _drop_short_loop(v, 1e-6))
+
+
+def _sweeper(monkeypatch) -> S.Sweeper:
+    got = {}
+    orig = S.Sweeper.along
+
+    def along(self, q0, q1):
+        got.setdefault("sw", self)
+        return orig(self, q0, q1)
+
+    monkeypatch.setattr(S.Sweeper, "along", along)
+    partial_region(Scene.load("sensorplan_gym/scenes/lab.json"), target_in="goal", theta=0.0)
+    return got["sw"]
+
+
+def test_batched_labels_equal_ring_by_ring(monkeypatch) -> None:
+    sw = _sweeper(monkeypatch)
+    n_moving = 0
+    for key in list(sw._frames)[:6]:
+        shadow, table, tid = sw.shadow(np.asarray(key))
+        for ring in S._rings(shapely.orient_polygons(shadow, exterior_cw=False)):
+            v = S._drop_short(np.asarray(ring.coords)[:-1, :2], sw.tol_lab)
+            one = sw._label(v, table, tid)
+            d = np.roll(v, -1, axis=0) - v
+            both = sw._label(np.vstack([v, v[::-1]]), table, tid, d=np.vstack([d, -d[::-1]]))
+            assert np.array_equal(both[: len(v)], one)
+            n_moving += int((one >= sw.n_fixed).any(axis=1).sum())
+    assert n_moving > 0
+
+
+def _all_at_once(sw: S.Sweeper, vs, ve, ts, q0, dq) -> tuple[np.ndarray, np.ndarray]:
+    """Validity with every probe tested at once (the definition), and with the first
+    round's probes only."""
+    d = ve - vs
+    ln = np.hypot(d[..., 0], d[..., 1])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        u = d / ln[..., None]
+    h = np.minimum(sw.h, 0.05 * ln)[..., None]
+    nrm = S._rot(u) * (1e-3 * h)
+    fixed = np.broadcast_to(np.arange(1, sw.probes) / sw.probes, ln.shape + (sw.probes - 1,))
+    fr = np.concatenate([fixed, sw._between_lines(vs, d, ts, q0, dq)], axis=-1)
+    eh = (h[..., 0] / np.where(ln > 0, ln, 1.0))[..., None]
+    fr = np.clip(np.where(np.isfinite(fr), fr, 0.5), eh, 1 - eh)
+    ends = np.stack([vs + h * u + nrm, ve - h * u + nrm], axis=-2)
+    inner = vs[..., None, :] + fr[..., None] * d[..., None, :] + nrm[..., None, :]
+    q = q0 + ts[..., None] * dq
+    every = sw._probes_blind(np.concatenate([ends, inner], axis=-2), q) & (ln > 0)
+    first = sw._probes_blind(np.concatenate([ends, inner[..., : sw.probes - 1, :]], axis=-2), q)
+    return every, first & (ln > 0)
+
+
+def test_two_round_probing_equals_testing_every_probe(monkeypatch) -> None:
+    sw = _sweeper(monkeypatch)
+    keys = [np.asarray(k) for k in sw._frames]
+    by_second = 0
+    for q0, q1 in zip(keys[:-1], keys[1:], strict=True):
+        dq = q1 - q0
+        edges = sw._edges(*sw.shadow(q0))
+        if not edges or not np.hypot(*dq) > 0:
+            continue
+        ts = np.broadcast_to(np.linspace(0.0, 1.0, 9), (len(edges), 9))
+        vs, ve = sw._ends_many(edges, ts, q0, dq)
+        got = sw._valid_many(vs, ve, ts, q0, dq)
+        every, first = _all_at_once(sw, vs, ve, ts, q0, dq)
+        assert np.array_equal(got, every)
+        by_second += int((first & ~every).sum())
+    assert by_second > 0  # not vacuous: the second round decides some of them
