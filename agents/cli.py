@@ -208,7 +208,10 @@ def build_parser() -> argparse.ArgumentParser:
         "(geometry.families.DIFFICULTIES; default: the plain random-scene generator)",
     )
     bm.add_argument(
-        "--splits", nargs="+", default=None, help="train, test, ood, ood:<scene>, real, real:<map> (default: train test ood)"
+        "--splits",
+        nargs="+",
+        default=None,
+        help="train, test, ood, ood:<scene>, real, real:<map> (default: train test ood)",
     )
     bm.add_argument("--env-kwargs", type=_json_dict, default=None)
     bm.add_argument(

@@ -167,8 +167,10 @@ def _in_sight(free: Any, g: shapely.Point, sep: float, step: float) -> shapely.P
     pts = pts[far & shapely.contains(free, pts)]
     segs = shapely.linestrings(
         np.stack(
-            [np.column_stack([shapely.get_x(pts), shapely.get_y(pts)]),
-             np.broadcast_to([g.x, g.y], (len(pts), 2))],
+            [
+                np.column_stack([shapely.get_x(pts), shapely.get_y(pts)]),
+                np.broadcast_to([g.x, g.y], (len(pts), 2)),
+            ],
             axis=1,
         )
     )

@@ -8,9 +8,10 @@ from any start, has no recognizing placement: it is excluded from the rate and c
 separately.  For every benchmark level of ``--levels`` (:data:`geometry.families.DIFFICULTIES`),
 K episodes of the level's test split (a pool of 64 family scenes, as
 ``sensorplan benchmark --level`` plays), from random starts at the level's
-``min_start_distance``.  Prints the table and writes the data (``oracle.json``) and the page fragment
-(``oracle.md``) to ``--out`` (default ``runs/benchmarks/oracle/``); with ``--update-results``
-the tracked ``benchmarks/results/oracle.json`` and ``docs/results/oracle.md`` instead.
+``min_start_distance``.  Prints the table and writes the data (``oracle.json``) and the page
+fragment (``oracle.md``) to ``--out`` (default ``runs/benchmarks/oracle/``); with
+``--update-results`` the tracked ``benchmarks/results/oracle.json`` and
+``docs/results/oracle.md`` instead.
 """
 
 from __future__ import annotations

@@ -92,9 +92,7 @@ def run_one(batch: int, epochs: int, timesteps: int, seed: int, tmp: Path) -> di
         "n_epochs": epochs,
         "timesteps": timesteps,
         "seed": seed,
-        "cpu_s": round(
-            (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime), 1
-        ),
+        "cpu_s": round((after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime), 1),
         "wall_s": round(wall, 1),
         "eval_timesteps": [int(t) for t in ev["timesteps"]],
         "eval_success": [float(s) for s in ev["successes"].mean(axis=1)],

@@ -206,15 +206,13 @@ def render(data: dict[str, Any]) -> str:
     ]
     for r in data["rows"]:
         s = r["agent_steps_per_s"]
-        lines.append(
-            f"| {r['env']} | {r['rows']} | {s:,.0f} | {s / nav:.2f} | {s / cart:.3f} |"
-        )
+        lines.append(f"| {r['env']} | {r['rows']} | {s:,.0f} | {s / nav:.2f} | {s / cart:.3f} |")
     m = data["machine"]
     lines += [
         "",
         f"`{data['command']}`: random actions on `{data['scene']}` (never declaring), vector "
         f"envs of {data['batch']} rows (copies x watchers for watch_v0), resets included "
-        f"(A's motion is planned at every episode start) except in the \"no resets\" row; "
+        f'(A\'s motion is planned at every episode start) except in the "no resets" row; '
         f"median of {data['repeats']} interleaved chunks of about {data['seconds']} s; "
         f"{m['cpus']} CPUs, load average {m['load_average']} (compare the ratios).",
     ]

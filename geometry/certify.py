@@ -245,8 +245,14 @@ def _recognizable_bounds(
     )
     sides = [
         _side(
-            scene, me, theta, eps_pos, eps_aim, tol,
-            dataclasses.replace(budget, offset=off, total=n_g + n_h), densify,
+            scene,
+            me,
+            theta,
+            eps_pos,
+            eps_aim,
+            tol,
+            dataclasses.replace(budget, offset=off, total=n_g + n_h),
+            densify,
             strips=overlap_strips(target, scene.region(other), *acc),
         )  # fmt: skip
         for (me, other), off in ((("goal", "failure"), 0), (("failure", "goal"), n_g))
@@ -310,9 +316,7 @@ def _dist(region: shapely.Geometry, pts: np.ndarray) -> np.ndarray:
         return np.zeros(0)
     rings = [r for p in shapely.get_parts(region) for r in (p.exterior, *p.interiors)]
     coords = [np.asarray(r.coords)[:, :2] for r in rings]
-    segs = shapely.linestrings(
-        np.concatenate([np.stack([c[:-1], c[1:]], axis=1) for c in coords])
-    )
+    segs = shapely.linestrings(np.concatenate([np.stack([c[:-1], c[1:]], axis=1) for c in coords]))
     tree = shapely.STRtree(segs)
     points = shapely.points(pts)
     (_, _), d = tree.query_nearest(points, return_distance=True, all_matches=False)

@@ -493,8 +493,12 @@ def _sees_whole(obs: shapely.Geometry, walls: shapely.Geometry, hull: np.ndarray
 
 
 def _clear_lines(
-    p: np.ndarray, pts: np.ndarray, obs: shapely.Geometry, walls: shapely.Geometry,
-    target: shapely.Geometry, back: float,
+    p: np.ndarray,
+    pts: np.ndarray,
+    obs: shapely.Geometry,
+    walls: shapely.Geometry,
+    target: shapely.Geometry,
+    back: float,
 ) -> np.ndarray:
     """Per target point ``pts[k]``: the segment from ``p`` to it, ending ``back`` short of
     it, lies in ``walls``, misses ``obs`` and misses ``target`` (self-occlusion)."""

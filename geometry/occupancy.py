@@ -99,9 +99,7 @@ def read_pgm(path: str | PathLike[str]) -> tuple[np.ndarray, int]:
         raise FormatError(f"{p}: cannot read: {e.strerror or e}") from None
     magic = data[:2]
     if magic not in (b"P5", b"P2"):
-        raise FormatError(
-            f"{p}: not a PGM image (expected magic 'P5' or 'P2', got {magic[:2]!r})"
-        )
+        raise FormatError(f"{p}: not a PGM image (expected magic 'P5' or 'P2', got {magic[:2]!r})")
     # header: magic, width, height, maxval, separated by whitespace; '#' comments to EOL
     fields: list[int] = []
     i = 2
@@ -256,8 +254,10 @@ class RosMap:
     @property
     def n_edges(self) -> int:
         """Edges of the boundary and all obstacles."""
-        return len(self.boundary.exterior.coords) - 1 + sum(
-            len(o.exterior.coords) - 1 for o in self.obstacles
+        return (
+            len(self.boundary.exterior.coords)
+            - 1
+            + sum(len(o.exterior.coords) - 1 for o in self.obstacles)
         )
 
 

@@ -584,9 +584,7 @@ class Sweeper:
         x0, vx = np.vstack(mov0), np.vstack(vel)
         with np.errstate(divide="ignore", invalid="ignore"):
             # x0 + t vx on the line (p0, w)
-            ta = _cross(w[:, None, :], p0[:, None, :] - x0[None]) / _cross(
-                w[:, None, :], vx[None]
-            )
+            ta = _cross(w[:, None, :], p0[:, None, :] - x0[None]) / _cross(w[:, None, :], vx[None])
             ii, kk = np.triu_indices(self.m, 1)
             wt = self.ring0[kk] - self.ring0[ii]
             a0 = self.ring0 + q0v
@@ -611,9 +609,7 @@ class Sweeper:
         ai = a0[ii[pb]] + tb[:, None] * dq
         ak = a0[kk[pb]] + tb[:, None] * dq
         bb = b[lb]
-        near = np.where(
-            (np.hypot(*(ai - bb).T) <= np.hypot(*(ak - bb).T))[:, None], ai, ak
-        )
+        near = np.where((np.hypot(*(ai - bb).T) <= np.hypot(*(ak - bb).T))[:, None], ai, ak)
         seg_b = np.stack([bb, near], axis=1)
         segs = np.concatenate([seg_a, seg_b])
         t = np.concatenate([ta, tb])

@@ -14,8 +14,8 @@ without a prior import.  Rewards are exact: they come from
 #: here only; pyproject.toml reads it, CHANGELOG.md lists what each version changed
 __version__ = "0.1.0"
 
-from .core.world import BUNDLED_SCENES  # noqa: E402
 from .core.scenes import REAL_SCENES  # noqa: E402
+from .core.world import BUNDLED_SCENES  # noqa: E402
 from .registration import ENV_IDS, register_sensorplan_envs  # noqa: E402
 
 register_sensorplan_envs()

@@ -116,9 +116,7 @@ class WatchExpert:
                     turn = _wrap(aim - psi) / env.max_turn
             else:
                 turn = _wrap(plan.aim - psi) / env.max_turn
-        return np.array(
-            [fwd, lat, float(np.clip(turn, -1, 1)), self.decide(i)], dtype=np.float32
-        )
+        return np.array([fwd, lat, float(np.clip(turn, -1, 1)), self.decide(i)], dtype=np.float32)
 
     def decide(self, i: int) -> float:
         """The decide component for watcher ``i`` now: -1 (G), +1 (H) or 0 (not yet / done)."""

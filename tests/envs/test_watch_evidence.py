@@ -122,4 +122,4 @@ def test_env_evidence_points_at_where_A_rests(seed):
     assert (hits[:, wrong] == 0).all(), (where, hits)
     assert hits[:, right].max() > 0, (where, hits)
     feats = np.stack([obs[a][-N_EVIDENCE:] for a in obs])
-    np.testing.assert_allclose(feats[:, :2], 1 - 0.5 ** hits, rtol=1e-6)
+    np.testing.assert_allclose(feats[:, :2], 1 - 0.5**hits, rtol=1e-6)

@@ -115,10 +115,14 @@ def _violations(scene, inner, outer, pts, passes) -> tuple[list, list]:
     in_inner = shapely.contains_xy(inner, pts[:, 0], pts[:, 1])
     in_outer = shapely.contains_xy(outer, pts[:, 0], pts[:, 1])
     bad_inner = [
-        tuple(p) for p, i, d, ok in zip(pts, in_inner, d_in, passes) if i and d > m and not ok
+        tuple(p)
+        for p, i, d, ok in zip(pts, in_inner, d_in, passes, strict=True)
+        if i and d > m and not ok
     ]
     bad_outer = [
-        tuple(p) for p, o, d, ok in zip(pts, in_outer, d_out, passes) if not o and d > m and ok
+        tuple(p)
+        for p, o, d, ok in zip(pts, in_outer, d_out, passes, strict=True)
+        if not o and d > m and ok
     ]
     return bad_inner, bad_outer
 

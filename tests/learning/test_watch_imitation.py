@@ -4,7 +4,6 @@ does not -- and the saved policy acts as the trained one."""
 
 from __future__ import annotations
 
-
 import numpy as np
 import pytest
 

@@ -46,7 +46,7 @@ def test_expert_is_a_function_of_the_state():
     ex = WatchExpert(env)
     obs, _ = env.reset(seed=SEEDS[0])
     rng = np.random.default_rng(0)
-    for t in range(60):  # random driving: states the oracle would never visit
+    for _ in range(60):  # random driving: states the oracle would never visit
         obs, *_ = env.step({a: rng.uniform(-1, 1, 4).astype(np.float32) for a in env.agents})
         a1 = ex.act(obs)
     a2 = WatchExpert(env).act(obs)
