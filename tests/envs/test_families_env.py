@@ -14,19 +14,9 @@ from geometry.families import DIFFICULTIES, FAMILIES, HARD, SceneFamily, scene_p
 from geometry.generate import random_scene
 from sensorplan_gym.core import fused
 from tests.envs.test_fused import _episodes
+from tests.planning.test_oracle import rollout
 
 NAV = "sensorplan/Navigate-v0"
-
-
-def rollout(env, policy, seed: int) -> dict:
-    obs, info = env.reset(seed=seed)
-    start, done = True, False
-    while not done:
-        action, _ = policy.predict(obs, episode_start=start)
-        start = False
-        obs, _, term, trunc, info = env.step(action)
-        done = term or trunc
-    return info
 
 
 @pytest.mark.parametrize("name", ["easy", "medium"])
