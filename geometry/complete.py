@@ -45,6 +45,10 @@ if TYPE_CHECKING:  # pragma: no cover
 
 __all__ = ["complete_region", "tangent_wedges"]
 
+#: A point touching the target's hull within this many tolerances of a hull vertex touches
+#: it at that vertex (see :func:`_touching_cones`).
+NEAR_REL = 100.0
+
 
 def complete_region(
     scene: Scene,
@@ -245,18 +249,42 @@ def _touching_cones(
             nang = np.where(far, np.arctan2(v[:, 1], v[:, 0]), nang)
             lo, hi = nang - np.pi / 2, nang + np.pi / 2
         return touch, lo, hi
-    # at a vertex of K: bounded by the lines of the two edges there
-    at_start = tt * L <= tol
-    at_end = (1 - tt) * L <= tol
+    # at a vertex of K: bounded by the lines of the two edges there.  "At a vertex" means
+    # within ``near`` of it: a point touching an edge 2e-9 from its end (fuzz contact
+    # seed 100163, a needle obstacle at the target's corner) would otherwise get that
+    # edge's half-plane, which no other query agrees with (the any-orientation disc's
+    # tangent half-plane there differs), while the vertex cone lies in both and hides at
+    # most a piece of the target ``near`` long behind the contact point.  A hull edge
+    # shorter than ``near`` (near-duplicate vertices, issue 26 item 1) has a direction
+    # decided by rounding: such a vertex cluster is one vertex, and its edges run to the
+    # first hull vertices farther than ``near`` on either side.
+    near = NEAR_REL * tol
+    at_start = tt * L <= near
+    at_end = (1 - tt) * L <= near
     vert = np.where(at_start, jj, (jj + 1) % m)
-    is_v = at_start | at_end
-    nxt, prv = k[(vert + 1) % m], k[(vert - 1) % m]
+    is_v = at_start | at_end | (L <= near)
+    nxt, prv = _beyond(k, vert, 1, near), _beyond(k, vert, -1, near)
     kv = k[vert]
     a1 = np.arctan2(kv[:, 1] - nxt[:, 1], kv[:, 0] - nxt[:, 0])  # beyond the outgoing edge
     a2 = np.arctan2(kv[:, 1] - prv[:, 1], kv[:, 0] - prv[:, 0])  # beyond the incoming edge
     lo = np.where(is_v, a1, lo)
     hi = np.where(is_v, a1 + (a2 - a1) % (2 * np.pi), hi)
     return touch, lo, hi
+
+
+def _beyond(k: np.ndarray, vert: np.ndarray, step: int, near: float) -> np.ndarray:
+    """Per row: the first hull vertex after ``k[vert]`` in direction ``step`` (+1 or -1)
+    farther than ``near`` from it (the farthest one if none is)."""
+    m = len(k)
+    out = k[(vert + step) % m].copy()
+    found = np.hypot(*(out - k[vert]).T) > near
+    for s in range(2, m):
+        if found.all():
+            break
+        cand = k[(vert + step * s) % m]
+        ok = ~found & (np.hypot(*(cand - k[vert]).T) > near)
+        out[ok], found = cand[ok], found | ok
+    return out
 
 
 def _far_on_line(u: np.ndarray, i: np.ndarray, k: np.ndarray, tol: float) -> np.ndarray:

@@ -102,6 +102,13 @@ def weak_visibility(
             backs = gaps_many(dom, np.asarray(back_q), sectors=np.asarray(back_sec))
             for gb in backs:
                 fans += _fans(gb, gb.seg >= 0, dom, eps_aim)
+    # fans narrower than the contact tolerance (a sliver anchored at a vertex within tol
+    # of a contact, area ~1e-20) are noise, and GEOS's floating union of such slivers
+    # can fill a pocket that no fan covers (fuzz contact seed 100375, scaled frame)
+    arr = np.asarray(fans, dtype=object)
+    thick = shapely.area(arr) > CONTACT_REL * dom.scale * shapely.length(arr)
+    n_direct = int(thick[:n_direct].sum())
+    fans = list(arr[thick])
     if not fans:
         return shapely.Polygon()
     return _union(fans, n_first=n_direct)
