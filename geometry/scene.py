@@ -744,6 +744,13 @@ class Scene:
         return g
 
     @functools.cached_property
+    def _boundary_lines(self) -> BaseGeometry:
+        rings = shapely.get_rings(np.asarray([self.bounds_geom, *self.obstacle_geoms]))
+        g = shapely.MultiLineString([np.asarray(r.coords) for r in rings])
+        shapely.prepare(g)
+        return g
+
+    @functools.cached_property
     def _obstacles_shrunk(self) -> BaseGeometry:
         g = self.obstacle_union.buffer(-self.tol, join_style="mitre")
         shapely.prepare(g)
@@ -809,6 +816,17 @@ class Scene:
                     return (f"obstacles[{i}]", x, y)
             x, y = _witness(self._obstacles_shrunk.intersection(geom), geom)
             return ("the obstacles", x, y)
+        # an obstacle (or a slit of the walls) thinner than 2 tol vanishes when shrunk, yet
+        # its boundary can run deep into ``geom``: it overlaps by more than tol too (fuzz
+        # contact seed 101082: a needle 1e-9 D wide 3.5e-3 D inside the target's hull)
+        core = shapely.buffer(geom, -self.tol, join_style="mitre")
+        if not core.is_empty and self._boundary_lines.intersects(core):
+            for i, op in enumerate(self.obstacle_geoms):
+                if op.boundary.intersects(core):
+                    x, y = _witness(op.boundary.intersection(core), geom)
+                    return (f"obstacles[{i}]", x, y)
+            x, y = _witness(self.bounds_geom.exterior.intersection(core), geom)
+            return ("the bounds (walls)", x, y)
         return None
 
     def check_clear(self, hull: BaseGeometry, what: str) -> None:

@@ -572,3 +572,15 @@ def test_target_at_property(lab_scene, x, y, theta):
     assert a.centroid.y == pytest.approx(y, abs=1e-9)
     assert a.is_valid
     assert shapely.is_ccw(a.exterior)
+
+
+def test_check_clear_sees_needles(lab_dict):
+    """An obstacle thinner than 2 tol vanishes when shrunk, yet it meets a hull its tip
+    runs deep into (fuzz contact seed 101082); lying flush along the hull it touches."""
+    lab_dict["obstacles"].append([[0.5, 8.5], [2.0, 8.5 + 5e-10], [0.5, 8.5 + 1e-9]])
+    s = Scene.from_dict(lab_dict)
+    n = len(lab_dict["obstacles"]) - 1
+    with pytest.raises(SceneError, match=rf"needle: meets obstacles\[{n}\] at \(2, 8\.5\)"):
+        s.check_clear(box(1.5, 7.5, 2.5, 9.5), "needle")
+    s.check_clear(box(1.0, 8.5 + 1e-9, 1.8, 9.5), "flush along the needle")
+    s.check_clear(box(2.0, 8.0, 3.0, 9.0), "the needle's tip on an edge")
