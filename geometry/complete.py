@@ -38,16 +38,13 @@ from ._common import (
 )
 from ._frame import world_messages
 from ._shapes import snapped, union_all
+from .scene import NEAR_REL
 from ._vis import visibility_polygon
 
 if TYPE_CHECKING:  # pragma: no cover
     from .scene import Scene
 
 __all__ = ["complete_region", "tangent_wedges"]
-
-#: A point touching the target's hull within this many tolerances of a hull vertex touches
-#: it at that vertex (see :func:`_touching_cones`).
-NEAR_REL = 100.0
 
 
 def complete_region(

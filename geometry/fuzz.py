@@ -698,6 +698,18 @@ def check_scene(
             )
             incl(r52, p_g, "recognizable 5.2 ⊆ R(G)")
             incl(r52, p_h, "recognizable 5.2 ⊆ R(H)")
+            if frames and r52 is not None and theta == 0.0:
+                # ... and it is recognizable for every pose pair: G and H shrunk to one
+                # vertex each gives the stationary recognizable region (issue 25 item 3)
+                try:
+                    st = s.replace(goal=s.goal[:1].tolist(), failure=s.failure[:1].tolist())
+                except SceneError:
+                    st = None
+                if st is not None:
+                    rs = _timed(
+                        lambda: recognizable_region(st, model="partial"), "recog at g, h", out, {}
+                    )
+                    incl(r52, rs, "recognizable 5.2 ⊆ stationary recognizable")
         if mixed_gh:  # one point, one polygon (issue 25)
             rmx = run(
                 "recognizable partial mixed",
@@ -720,18 +732,6 @@ def check_scene(
                         {},
                     )
                 incl(rmx, rw, f"recognizable mixed ⊆ R({w})")
-            if frames and r52 is not None and theta == 0.0:
-                # ... and it is recognizable for every pose pair: G and H shrunk to one
-                # vertex each gives the stationary recognizable region (issue 25 item 3)
-                try:
-                    st = s.replace(goal=s.goal[:1].tolist(), failure=s.failure[:1].tolist())
-                except SceneError:
-                    st = None
-                if st is not None:
-                    rs = _timed(
-                        lambda: recognizable_region(st, model="partial"), "recog at g, h", out, {}
-                    )
-                    incl(r52, rs, "recognizable 5.2 ⊆ stationary recognizable")
     if frames:
         _check_frames(s, d, q_at, theta, out, swept=swept, poly_gh=poly_gh)
     if translate:

@@ -56,10 +56,17 @@ from shapely.geometry.base import BaseGeometry
 from ._frame import IDENTITY, Frame, frame_params, to_world_point, world_messages
 from ._shapes import areal, snap_grid
 
-__all__ = ["SceneError", "SensorSpec", "Scene", "TOL_REL", "PAPER_ASSUMPTION"]
+__all__ = ["SceneError", "SensorSpec", "Scene", "TOL_REL", "NEAR_REL", "PAPER_ASSUMPTION"]
 
 #: Relative tolerance: ``scene.tol = TOL_REL * scene.diameter``.
 TOL_REL = 1e-9
+
+#: Target vertices closer than ``NEAR_REL * scene.tol`` (1e-7 D) are one vertex, and a point
+#: touching the target's hull that close to a hull vertex touches it at that vertex: an edge
+#: so short has a direction set by rounding, and a tolerance of one ``tol`` left the near-
+#: duplicates of the fuzzer (1.0-1.1 tol apart) to be decided by it (docs/DESIGN.md,
+#: "Contacts", rule 2).
+NEAR_REL = 100.0
 
 #: Text appended to every violation of the paper's stated assumption (Briggs & Donald 3.1.1).
 PAPER_ASSUMPTION = (
@@ -217,9 +224,9 @@ def _parse_points(value: Any, where: str, *, allow_point: bool = False) -> np.nd
 
 
 def _merge_near(a: np.ndarray, where: str, tol: float) -> np.ndarray:
-    """The CCW ring ``a`` with every vertex closer than ``tol`` (``TOL_REL`` times the
-    scene's diameter) to the previous kept vertex dropped (docs/DESIGN.md, "Contacts"): two target
-    vertices 1e-9 D apart made an edge whose direction is rounding noise, and the region
+    """The CCW ring ``a`` with every vertex closer than ``tol`` (``NEAR_REL * TOL_REL`` times
+    the scene's diameter) to the previous kept vertex dropped (docs/DESIGN.md, "Contacts"): two
+    target vertices 1e-9 D apart made an edge whose direction is rounding noise, and the region
     algorithms took it for a real edge (issue 26 item 1).  Raises ``SceneError`` when
     fewer than 3 vertices remain."""
     keep = [0]
@@ -499,7 +506,9 @@ class Scene:
             raise SceneError(f"obstacles: expected a list of polygons, got {_short(obs_in)}")
         obstacles = tuple(_parse_points(o, f"obstacles[{i}]") for i, o in enumerate(obs_in))
         diam = float(np.hypot(*np.ptp(bounds, axis=0)))
-        target = _merge_near(_parse_points(d["target"], "target"), "target", TOL_REL * diam)
+        target = _merge_near(
+            _parse_points(d["target"], "target"), "target", NEAR_REL * TOL_REL * diam
+        )
         goal = _parse_points(d["goal"], "goal", allow_point=True)
         failure = _parse_points(d["failure"], "failure", allow_point=True)
         sensor = SensorSpec.from_dict(d.get("sensor"))
