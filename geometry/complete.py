@@ -38,8 +38,8 @@ from ._common import (
 )
 from ._frame import world_messages
 from ._shapes import snapped, union_all
-from .scene import NEAR_REL
 from ._vis import visibility_polygon
+from .scene import NEAR_REL
 
 if TYPE_CHECKING:  # pragma: no cover
     from .scene import Scene

@@ -155,8 +155,25 @@ def test_contact_generator_draws_the_issue26_families():
 #: 100724 (a needle obstacle 1e-9 D wide 3.5e-3 D inside the target's hull passed
 #: ``Scene.check_clear``, which shrinks obstacles by tol: now the paper's assumption fails),
 #: 103828 (frame: a near-duplicate target vertex 1.1 tol from a needle's tip, its 1e-9 edge
-#: covered in one frame and wanted in the other: target vertices merge within 1e-7 D now).
-CONTACT_REGRESSION_SEEDS = [540, 1672, 320, 100163, 100267, 103089, 100375, 101082, 100724, 103828]
+#: covered in one frame and wanted in the other: target vertices merge within 1e-7 D now),
+#: 104657 (frame: an obstacle vertex 1.7 tol from the target's corner, within tol of both
+#: its edges, was inserted on both: a spike), 108386 (frame: a needle touching the target's
+#: corner; the corner's fan saw the edge beside it past the needle: a pinch now blocks the
+#: direct anchors' fans as it blocked the grazing ones).
+CONTACT_REGRESSION_SEEDS = [
+    540,
+    1672,
+    320,
+    100163,
+    100267,
+    103089,
+    100375,
+    101082,
+    100724,
+    103828,
+    104657,
+    108386,
+]
 
 
 @pytest.mark.parametrize("seed", CONTACT_REGRESSION_SEEDS)
