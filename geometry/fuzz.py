@@ -46,8 +46,8 @@ under an opening, a second obstacle sharing a flush one's edge.
 with ``swept`` scenes that mix a point and a polygon also run the mixed recognizable
 region (``⊆`` the partial regions of both; issue 25).
 
-``python -m geometry.fuzz --n 10000 [--swept] [--contacts] [--frames] [--nonstar]`` runs the
-long version and prints a table; ``tests/geometry/test_fuzz.py`` runs a fast one in the
+``python -m geometry.fuzz --n 10000 [--swept] [--contacts] [--frames] [--nonstar] [--jobs N]``
+runs the long version and prints a table; ``tests/geometry/test_fuzz.py`` runs a fast one in the
 default test run.
 """
 
@@ -899,8 +899,19 @@ def run_many(
     contacts: bool = False,
     frames: bool = False,
     nonstar: bool = False,
+    jobs: int = 1,
 ) -> dict[str, Any]:
-    """Fuzz ``n`` scenes (seeds ``seed .. seed + n - 1``); returns a summary dictionary."""
+    """Fuzz ``n`` scenes (seeds ``seed .. seed + n - 1``); returns a summary dictionary.
+
+    ``jobs`` > 1 splits the seeds into that many contiguous chunks run in separate
+    processes (the summary is the same as one process's, ``seconds`` is wall time)."""
+    if not isinstance(jobs, int) or jobs < 1:
+        raise ValueError(f"jobs must be a positive integer, got {jobs!r}")
+    if jobs > 1 and n > 1:
+        return _run_parallel(
+            n, seed, jobs, dict(swept=swept, max_edges=max_edges, verbose=verbose,
+                                contacts=contacts, frames=frames, nonstar=nonstar),
+        )  # fmt: skip
     kinds: Counter[str] = Counter()
     failing: list[dict[str, Any]] = []
     slowest: dict[str, float] = {}
@@ -932,6 +943,35 @@ def run_many(
     }
 
 
+def _run_parallel(n: int, seed: int, jobs: int, kw: dict[str, Any]) -> dict[str, Any]:
+    from concurrent.futures import ProcessPoolExecutor
+
+    t0 = time.perf_counter()
+    per = -(-n // jobs)
+    chunks = [(s0, min(per, seed + n - s0)) for s0 in range(seed, seed + n, per)]
+    with ProcessPoolExecutor(len(chunks)) as ex:
+        parts = list(ex.map(_run_chunk, [(c, kw) for c in chunks]))
+    kinds: Counter[str] = Counter()
+    slowest: dict[str, float] = {}
+    for r in parts:
+        kinds.update(r["violations"])
+        for k, v in r["slowest_query_s"].items():
+            slowest[k] = max(slowest.get(k, 0.0), v)
+    return {
+        "scenes": n,
+        "valid": sum(r["valid"] for r in parts),
+        "violations": dict(kinds),
+        "failing_scenes": [f for r in parts for f in r["failing_scenes"]],
+        "slowest_query_s": dict(sorted(slowest.items())),
+        "seconds": round(time.perf_counter() - t0, 1),
+    }
+
+
+def _run_chunk(arg: tuple[tuple[int, int], dict[str, Any]]) -> dict[str, Any]:
+    (s0, k), kw = arg
+    return run_many(k, seed=s0, **kw)
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="python -m geometry.fuzz", description=__doc__.split("\n")[0])
     ap.add_argument("--n", type=int, default=200, help="number of seeds (default 200)")
@@ -949,6 +989,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument(
         "--nonstar", action="store_true", help="non-star-shaped targets (U, comb, hook; issue 25)"
     )
+    ap.add_argument("--jobs", type=int, default=1, help="processes (default 1)")
     ap.add_argument("--json", help="write the summary (with failing seeds) to this file")
     ap.add_argument("-v", "--verbose", action="store_true")
     a = ap.parse_args(argv)
@@ -961,6 +1002,7 @@ def main(argv: list[str] | None = None) -> int:
         contacts=a.contacts,
         frames=a.frames,
         nonstar=a.nonstar,
+        jobs=a.jobs,
     )
     if a.json:
         with open(a.json, "w", encoding="utf-8") as f:

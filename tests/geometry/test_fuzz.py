@@ -214,3 +214,13 @@ def test_fuzz_contacts_and_frames(seed):
     findings, _ = check_scene(d, seed=seed, hang_s=60.0, frames=True)
     bad = [vars(f) for f in findings if f.kind in CONTACT_CLEAN]
     assert not bad, f"seed {seed} {d.get('features')}: {bad}"
+
+
+def test_run_many_in_processes_matches_one_process():
+    from geometry.fuzz import run_many
+
+    one = run_many(4, seed=100000, contacts=True)
+    two = run_many(4, seed=100000, contacts=True, jobs=2)
+    assert (two["valid"], two["violations"]) == (one["valid"], one["violations"])
+    with pytest.raises(ValueError, match="jobs must be a positive integer"):
+        run_many(4, jobs=0)
