@@ -132,7 +132,7 @@ def target_spec(
             0.0,
             np.asarray(area.centroid.coords[0]),
             (x, y, th),
-            "target at ({:g}, {:g}, {:g})".format(*to_world_point(x, y), th),
+            "target at ({:.10g}, {:.10g}, {:g})".format(*to_world_point(x, y), th),
         )
     else:
         region = _region(scene, target_in)

@@ -104,7 +104,7 @@ def _is_number(v: Any) -> bool:
 
 
 def _fmt(v: float) -> str:
-    return f"{float(v):.6g}"
+    return f"{float(v):.10g}"
 
 
 def _fmt_pt(x: float, y: float) -> str:
