@@ -36,7 +36,7 @@ from typing import Any
 import numpy as np
 import shapely
 
-from .planner import Placement, best_aim, choose_placement
+from .planner import Placement, best_aim, best_joint_aim, choose_placement
 from .recognition import classify
 
 __all__ = ["OraclePolicy", "ViewpointPlan", "plan_viewpoint"]
@@ -58,12 +58,9 @@ class ViewpointPlan:
     placement: Placement | None = field(default=None, repr=False)
 
 
-def _hull_points(world) -> np.ndarray:
-    return np.vstack(world.must_see)
-
-
 def _aim_for(world, p: np.ndarray) -> tuple[float, float]:
-    psi, margin = best_aim(p, _hull_points(world), world.fov, world.eps_aim)
+    # one aim for K_G and K_H: their union, not its hull (which may hold p)
+    psi, margin = best_joint_aim(p, world.must_see, world.fov, world.eps_aim)
     return float(psi), float(margin)
 
 

@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -47,6 +48,7 @@ __all__ = [
     "Path",
     "Placement",
     "best_aim",
+    "best_joint_aim",
     "choose_placement",
     "grow_free_space",
     "shortest_path",
@@ -508,6 +510,55 @@ def best_aim(p: Any, target: Any, fov: float, eps_aim: float = 0.0) -> tuple[flo
             extent = max(extent, math.pi)
         if fov >= 2 * math.pi - 1e-12:
             psi = phi_c
+    psi = math.atan2(math.sin(psi), math.cos(psi))
+    if fov >= 2 * math.pi - 1e-12:
+        return psi, math.pi - extent / 2
+    return psi, (fov / 2 - eps_aim) - extent / 2
+
+
+
+def best_joint_aim(
+    p: Any, sets: Sequence[Any], fov: float, eps_aim: float = 0.0
+) -> tuple[float, float]:
+    """Aim that keeps every one of several convex ``sets`` in the field of view, with the
+    most margin: :func:`best_aim` for their union, not for the convex hull of the union.
+
+    From a placement *between* K_G and K_H the hull of both contains the sensor (extent
+    2 pi for :func:`best_aim`), yet a 229-degree sensor sees both if the two sets' angular
+    intervals leave a gap wider than 131 degrees (the oracle failed such a Placement-v0
+    episode of the ``hard`` level).  Each set's interval is :func:`best_aim`'s; the aim is
+    the bisector of the shortest arc covering them all (the circle minus the largest gap
+    between them).
+
+    Returns ``(psi, margin)`` as :func:`best_aim` (radians; ``margin < 0``: no aim works).
+    """
+    fov, eps_aim = float(fov), float(eps_aim)
+    ivs = []
+    for k in sets:
+        psi, margin = best_aim(p, k, fov, eps_aim)
+        full = (math.pi if fov >= 2 * math.pi - 1e-12 else fov / 2 - eps_aim) - margin
+        if full >= math.pi - 1e-12:  # p inside (or on the boundary at a vertex of) a set
+            return best_aim(p, np.vstack([_points_of(k) for k in sets]), fov, eps_aim)
+        ivs.append((psi - full, 2.0 * full))
+    if not ivs:
+        raise ValueError("best_joint_aim: no sets to aim at")
+    tau = 2 * math.pi
+    # the arcs unrolled twice round the circle, merged in order: every gap of the circle
+    # is a gap between two consecutive merged arcs
+    arcs = sorted((a % tau + k * tau, w) for a, w in ivs for k in (0, 1))
+    merged = [[arcs[0][0], arcs[0][0] + arcs[0][1]]]
+    for a, w in arcs[1:]:
+        if a <= merged[-1][1]:
+            merged[-1][1] = max(merged[-1][1], a + w)
+        else:
+            merged.append([a, a + w])
+    best_gap, best_end = 0.0, 0.0
+    for (_, e0), (s1, _) in zip(merged[:-1], merged[1:], strict=True):
+        if s1 - e0 > best_gap:
+            best_gap, best_end = s1 - e0, e0
+    extent = tau - best_gap
+    lo = best_end + best_gap  # the covering arc starts where the gap ends
+    psi = lo + extent / 2
     psi = math.atan2(math.sin(psi), math.cos(psi))
     if fov >= 2 * math.pi - 1e-12:
         return psi, math.pi - extent / 2

@@ -340,3 +340,34 @@ def test_keep_out_is_avoided_by_the_robot_body(open_room):
     assert pl.point[0] >= 6.5 + r - 1e-9  # the body does not overlap the keep-out area
     assert pl.path.as_linestring().distance(keep_out) >= r - 1e-9
     assert not pl.one_step  # the straight line through the keep-out area is not allowed
+
+
+def _square(cx: float, cy: float, h: float = 0.5) -> np.ndarray:
+    return np.array([[cx - h, cy - h], [cx + h, cy - h], [cx + h, cy + h], [cx - h, cy + h]])
+
+
+def test_best_joint_aim_sees_two_sets_from_between_them():
+    """From between K_G and K_H (inside the hull of both) a 229-degree sensor sees both:
+    best_aim on the hull says no aim works, best_joint_aim finds the aim (the oracle's
+    failed Placement-v0 episode of the hard level)."""
+    from agents.planning.planner import best_joint_aim
+
+    g, h = _square(5.0, 0.0), _square(-5.0, 0.5)
+    fov = math.radians(229.0)
+    assert best_aim((0.0, 0.0), np.vstack([g, h]), fov)[1] < 0
+    psi, margin = best_joint_aim((0.0, 0.0), [g, h], fov)
+    assert margin > 0
+    for k in (g, h):  # every vertex within fov / 2 - margin of the aim
+        d = np.arctan2(k[:, 1], k[:, 0]) - psi
+        off = np.abs((d + math.pi) % (2 * math.pi) - math.pi)
+        assert off.max() <= fov / 2 - margin + 1e-9
+    # a 150-degree sensor cannot (the two sets span about 186 degrees)
+    assert best_joint_aim((0.0, 0.0), [g, h], math.radians(150.0))[1] < 0
+    # one set, or both on one side: the same as best_aim on their union
+    p = (0.0, -10.0)
+    a1, m1 = best_joint_aim(p, [g, h], fov)
+    a2, m2 = best_aim(p, np.vstack([g, h]), fov)
+    assert m1 == pytest.approx(m2, abs=1e-9)
+    assert math.cos(a1 - a2) == pytest.approx(1.0)
+    # inside one of them: no aim keeps it in view
+    assert best_joint_aim((5.0, 0.0), [g, h], fov)[1] < 0
