@@ -32,8 +32,8 @@ to move around corners").  Here:
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
 from collections.abc import Sequence
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -514,7 +514,6 @@ def best_aim(p: Any, target: Any, fov: float, eps_aim: float = 0.0) -> tuple[flo
     if fov >= 2 * math.pi - 1e-12:
         return psi, math.pi - extent / 2
     return psi, (fov / 2 - eps_aim) - extent / 2
-
 
 
 def best_joint_aim(
