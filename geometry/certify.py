@@ -47,6 +47,7 @@ from ._common import (
     check_theta,
     check_tol,
     polygonal,
+    scene_domain,
     shrink_for_position,
 )
 from ._frame import world_messages
@@ -59,7 +60,7 @@ from .sweep import QueryTimeout
 if TYPE_CHECKING:  # pragma: no cover
     from .scene import Scene
 
-__all__ = ["SweptBounds", "hausdorff_bounds", "swept_bounds"]
+__all__ = ["SweptBounds", "hausdorff_bounds", "proven_inner", "swept_bounds"]
 
 #: The Hausdorff distance is bounded on cells refined from a grid of this many along the
 #: longer side of the gap's bounding box (:func:`hausdorff_bounds`) ...
@@ -83,6 +84,12 @@ class SweptBounds:
         value; ``inf`` when ``inner`` is empty and ``outer`` is not.
     hausdorff_lower : a lower bound on it (scene units).
     samples : how many exact stationary shadows make up the outer bound.
+    proven_inner : an inner bound proven without any claim about the sweep's tracing
+        (:func:`proven_inner`; world frame), or ``None`` where that argument does not apply
+        (5.2 and mixed G/H, a target that is not star-shaped, ``eps_aim`` > 0).  Looser than
+        ``inner``; ``densify`` tightens it.
+    proven_hausdorff : the upper Hausdorff bound between ``proven_inner`` and ``outer``
+        (``None`` with it).
     """
 
     inner: shapely.Geometry
@@ -90,6 +97,8 @@ class SweptBounds:
     hausdorff: float
     hausdorff_lower: float
     samples: int
+    proven_inner: shapely.Geometry | None = None
+    proven_hausdorff: float | None = None
 
 
 def swept_bounds(
@@ -144,11 +153,15 @@ def swept_bounds(
         )  # fmt: skip
         if recognizable:
             inner, outer, n = _recognizable_bounds(local, *args)
+            proven = None
         else:
-            inner, outer, n = _side(local, fr.region(target_in), *args)
+            inner, outer, n, proven = _side(local, fr.region(target_in), *args)
     inner, outer = fr.to_world(inner), fr.to_world(outer)
     hi, lo = hausdorff_bounds(inner, outer)
-    return SweptBounds(inner, outer, hi, lo, n)
+    if proven is None:
+        return SweptBounds(inner, outer, hi, lo, n)
+    proven = fr.to_world(proven)
+    return SweptBounds(inner, outer, hi, lo, n, proven, hausdorff_bounds(proven, outer)[0])
 
 
 def _side(
@@ -161,8 +174,9 @@ def _side(
     budget: Budget,
     densify: int = 0,
     strips: list[shapely.Geometry] | None = None,
-) -> tuple[shapely.Geometry, shapely.Geometry, int]:
-    """(inner, outer, number of sampled shadows) of one swept partial region, local frame."""
+) -> tuple[shapely.Geometry, shapely.Geometry, int, shapely.Geometry | None]:
+    """(inner, outer, number of sampled shadows, proven inner or None) of one swept partial
+    region, local frame."""
     sink: dict = {}
     inner = _swept_region(
         scene, target_in, theta, eps_pos, eps_aim, tol, True, strips=strips, budget=budget,
@@ -188,6 +202,13 @@ def _side(
     union = union_all(shadows, grid_size=grid) if shadows else shapely.Polygon()
     allowed = sink["allowed"]
     outer = polygonal(shapely.difference(allowed, union))
+    proven = None
+    if strips is None and stand_in is None and eps_aim == 0.0:
+        # star-shaped target, whole outline: an inner bound that needs no claim about
+        # the tracing (docs/DESIGN.md, "Certified swept answers")
+        proven = proven_inner(scene, sink["region"], theta, [q for q, _ in samples], allowed, grid)
+        if proven is not None and eps_pos > 0:
+            proven = shrink_for_position(proven, allowed, eps_pos)
     if eps_pos > 0:
         # shrink_for_position grows by a circumscribed polygon of radius r + 2 delta
         # (delta = 1e-9 * diag): keep that inside the eps disc, so outer stays outside E
@@ -195,7 +216,83 @@ def _side(
         r = eps_pos * math.cos(math.pi / 64) * (1 - 1e-9) - 2 * delta
         if r > 0:
             outer = shrink_for_position(outer, allowed, r)
-    return inner, outer, len(shadows)
+    return inner, outer, len(shadows), proven
+
+
+def proven_inner(
+    scene: Scene,
+    region: shapely.Geometry,
+    theta: float,
+    qs: list[np.ndarray],
+    allowed: shapely.Geometry,
+    grid: float,
+    max_split: int = 6,
+) -> shapely.Geometry | None:
+    """A proven inner bound of the swept partial region (whole outline wanted), local frame.
+
+    The reference points ``qs`` (on the boundary of the polygon ``region``) and the
+    region's vertices cut its boundary into pieces sigma = [q_a, q_b].  For every q on
+    sigma the target A_q contains B_sigma = the points of A covered at every position of
+    sigma (A_{q_a} minus the parallelograms its edges sweep along sigma), so a placement
+    outside A (+) G blind to A_q is blind to B_sigma: the segment to a visible point of
+    B_sigma enters A_q at a visible point first.  Hence the union of the shadows over
+    the boundary lies in the union of the exact stationary shadows S(B_sigma) of the
+    largest part of each B_sigma, and ``allowed`` minus the latter is inside the exact
+    region (given that the boundary of G suffices: star-shaped target).  A piece whose
+    B_sigma is empty (longer than the target is wide) is halved, up to ``max_split``
+    times; ``None`` if one stays empty.  Snap-rounded on ``grid`` like the outer bound.
+    """
+    from .partial import _hole_ring
+    from .weak import weak_visibility
+
+    if region.geom_type != "Polygon":
+        return None
+    ring = region.exterior
+    length = ring.length
+    verts = np.asarray(ring.coords)[:-1]
+    pos = np.concatenate(
+        [
+            shapely.line_locate_point(ring, shapely.points(verts)),
+            shapely.line_locate_point(ring, shapely.points(np.asarray(qs).reshape(-1, 2)))
+            if len(qs)
+            else np.empty(0),
+        ]
+    )
+    pos = np.unique(np.clip(pos, 0.0, length))
+    stops = np.append(pos, pos[0] + length)
+    pieces = [(a, b, 0) for a, b in zip(stops[:-1], stops[1:], strict=True) if b - a > 1e-12]
+    dom = scene_domain(scene)
+    shadows = []
+    while pieces:
+        a, b, depth = pieces.pop()
+        qa = np.asarray(ring.interpolate(a % length).coords[0])
+        qb = np.asarray(ring.interpolate(b % length).coords[0])
+        core = _covered(scene.target_at(float(qa[0]), float(qa[1]), theta), qb - qa)
+        if core is None:
+            if depth >= max_split:
+                return None
+            mid = 0.5 * (a + b)
+            pieces += [(a, mid, depth + 1), (mid, b, depth + 1)]
+            continue
+        hole = _hole_ring(core)
+        seen = weak_visibility(dom, hole, np.ones(len(hole), dtype=bool))
+        shadows.append(polygonal(shapely.difference(allowed, seen)))
+    union = union_all(shadows, grid_size=grid) if shadows else shapely.Polygon()
+    return polygonal(shapely.difference(allowed, union))
+
+
+def _covered(a: shapely.Polygon, d: np.ndarray) -> shapely.Polygon | None:
+    """The largest part of the points of ``a`` that stay in ``a + t d`` for all t in
+    [0, 1] (``a`` minus the parallelograms its edges sweep along ``d``), or ``None``."""
+    c = np.asarray(a.exterior.coords)
+    e = c[1:] - c[:-1]
+    swept = np.abs(e[:, 0] * d[1] - e[:, 1] * d[0]) > 0.0
+    quads = np.stack([c[:-1], c[1:], c[1:] + d, c[:-1] + d], axis=1)[swept]
+    core = a if len(quads) == 0 else shapely.difference(a, union_all(shapely.polygons(quads)))
+    parts = [g for g in shapely.get_parts(polygonal(core)) if g.area > 0.0]
+    if not parts:
+        return None
+    return max(parts, key=lambda g: g.area)
 
 
 def _whole_shadow(scene: Scene, q: np.ndarray, theta: float, eps_aim: float) -> shapely.Geometry:
@@ -229,7 +326,7 @@ def _recognizable_bounds(
         pt_name = next(w for w in names if scene.region(w).geom_type == "Point")
         poly_name = next(w for w in names if w != pt_name)
         point, poly = scene.region(pt_name), scene.region(poly_name)
-        inner, outer, n = _side(
+        inner, outer, n, _ = _side(
             scene, poly_name, theta, eps_pos, eps_aim, tol, budget, densify,
             strips=point_strips(target, point, *acc),
         )  # fmt: skip

@@ -160,6 +160,15 @@ def test_bounds_hold_against_dense_brute_force(name):
     bad_inner, bad_outer = _violations(scene, b.inner, b.outer, pts, passes)
     assert not bad_inner, f"{name}: inner placements blinded by a sampled q: {bad_inner[:5]}"
     assert not bad_outer, f"{name}: placements outside outer that see at every q: {bad_outer[:5]}"
+    star = "nonstar" not in name
+    assert (b.proven_inner is not None) == star
+    if star:  # the proven inner bound (no claim about the tracing): inside outer, never blind
+        assert shapely.difference(b.proven_inner, b.outer).area <= 1e-12 * D * D
+        assert b.proven_hausdorff >= 0
+        bad, _ = _violations(scene, b.proven_inner, b.outer, pts, passes)
+        assert not bad, f"{name}: proven-inner placements blinded by a sampled q: {bad[:5]}"
+        assert shapely.contains_xy(b.proven_inner, pts[:, 0], pts[:, 1]).sum() >= 50
+        print(f"{name}: proven inner: hausdorff <= {b.proven_hausdorff / D:.2e} D")
     # not vacuous: both kinds of placement were checked
     in_inner = shapely.contains_xy(b.inner, pts[:, 0], pts[:, 1])
     out_outer = ~shapely.contains_xy(b.outer, pts[:, 0], pts[:, 1])
