@@ -26,6 +26,7 @@ import json
 import multiprocessing
 import os
 import pickle
+import warnings
 from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor
 from typing import Any
@@ -139,10 +140,21 @@ class ScenePool:
         ``forkserver``).  The worlds are the same as a serial build's (each worker draws
         scene ``k`` from the same stream) and are sent back pickled.  With ``jobs > 1`` the
         pool's ``check`` must be picklable (a module-level function or a
-        :func:`functools.partial` of one, not a lambda).  Returns the pool."""
+        :func:`functools.partial` of one, not a lambda).  In a daemonic process (a worker of
+        gymnasium's ``AsyncVectorEnv``), which may not start processes, the build is serial
+        (with a ``RuntimeWarning``).  Returns the pool."""
         check_jobs(jobs)
         todo = [k for k in range(self.size) if k not in self.entries]
         jobs = min(int(jobs), len(todo))
+        if jobs > 1 and multiprocessing.current_process().daemon:
+            warnings.warn(
+                f"ScenePool.build(jobs={jobs}) in a daemonic process (e.g. a worker of "
+                "gymnasium's AsyncVectorEnv), which cannot start worker processes: building "
+                "serially",
+                RuntimeWarning,
+                stacklevel=2,
+            )
+            jobs = 1
         if jobs <= 1:
             for k in todo:
                 self.get(k)

@@ -154,3 +154,14 @@ def test_unpicklable_check_with_jobs_is_a_clear_error():
     with pytest.raises(TypeError, match="cannot be pickled"):
         pool.build(jobs=2)
     assert pool.build(jobs=1).entries.keys() == {0, 1}
+
+
+def test_a_daemonic_process_builds_serially(monkeypatch):
+    """Workers of gymnasium's AsyncVectorEnv are daemonic and may not start processes."""
+    import multiprocessing
+
+    monkeypatch.setattr(multiprocessing.current_process(), "daemon", True)
+    pool = ScenePool(WorldConfig(), CHECK, size=2, disk_cache=False)
+    with pytest.warns(RuntimeWarning, match="building serially"):
+        pool.build(jobs=2)
+    assert pool.entries.keys() == {0, 1}
