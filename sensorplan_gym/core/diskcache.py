@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import functools
 import hashlib
+import importlib.metadata
 import json
 import os
 import platform
@@ -63,10 +64,13 @@ def _code_digest() -> str:
     import numpy as np
 
     import geometry
-    import sensorplan_gym
 
+    try:  # the installed distribution's version (the core imports nothing above it)
+        version = importlib.metadata.version("sensorplan-gym")
+    except importlib.metadata.PackageNotFoundError:  # pragma: no cover - not installed
+        version = "unknown"
     h = hashlib.sha256()
-    h.update(f"format={FORMAT};version={sensorplan_gym.__version__};".encode())
+    h.update(f"format={FORMAT};version={version};".encode())
     h.update(
         f"numpy={np.__version__};shapely={shapely.__version__};geos={shapely.geos_version_string};"
         f"machine={platform.machine()};system={platform.system()};".encode()
