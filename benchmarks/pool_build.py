@@ -16,7 +16,7 @@ scene has paid the one-time costs (imports, compiled kernels).  Rows, in the ord
 * **cold, jobs=k**: the polygonal pool into an empty disk-cache folder, in k processes
   (``--jobs``); with one process each scene is timed on its own (median and 90th percentile
   per scene, and the share of the time spent in ``geometry.recognizable_region``);
-* **warm**: the same pool built again, serially, in a fresh env reading the folder the serial
+* **warm**: the same pool built again, serially, in a fresh env reading the folder the first
   cold build filled (the second build of a user: regions read, not computed).
 
 The last column extrapolates each total linearly to 1,024 scenes (``total x 1024 / N``);
@@ -29,6 +29,7 @@ Data (``pool_build.json``) and fragment (``pool_build.md``) go to ``--out`` (def
 from __future__ import annotations
 
 import argparse
+import os
 import tempfile
 import time
 from pathlib import Path
@@ -47,6 +48,12 @@ from . import _results
 ENV_ID = "sensorplan/Recognize-v0"
 POLY = {"model": "partial", "random_scene_kwargs": {"goal": "polygon", "failure": "polygon"}}
 TARGET = 1024
+
+
+def _cpu() -> float:
+    """CPU seconds (user + system) of this process and its finished children."""
+    t = os.times()
+    return t.user + t.system + t.children_user + t.children_system
 
 
 def _fresh() -> None:
@@ -71,6 +78,7 @@ def _serial(n: int, cache: Path | bool, **kw: Any) -> dict[str, Any]:
 
     world_mod.recognizable_region = timed
     try:
+        c0 = _cpu()
         t0 = time.perf_counter()
         env = gym.make(ENV_ID, scene="random", scene_pool_size=n, scene_pool_cache=cache, **kw)
         per = [time.perf_counter() - t0]
@@ -80,6 +88,7 @@ def _serial(n: int, cache: Path | bool, **kw: Any) -> dict[str, Any]:
             pool.get(k)
             per.append(time.perf_counter() - t)
         total = time.perf_counter() - t0
+        cpu = _cpu() - c0
     finally:
         world_mod.recognizable_region = orig
     c = pool.disk_cache
@@ -87,6 +96,7 @@ def _serial(n: int, cache: Path | bool, **kw: Any) -> dict[str, Any]:
     return {
         "jobs": 1,
         "total_s": total,
+        "cpu_s": cpu,
         "median_s": float(np.median(p)),
         "p90_s": float(np.percentile(p, 90)),
         "max_s": float(p.max()),
@@ -99,6 +109,7 @@ def _serial(n: int, cache: Path | bool, **kw: Any) -> dict[str, Any]:
 def _parallel(n: int, jobs: int, cache: Path, **kw: Any) -> dict[str, Any]:
     """Build the pool of ``n`` scenes at construction in ``jobs`` processes."""
     _fresh()
+    c0 = _cpu()
     t0 = time.perf_counter()
     env = gym.make(
         ENV_ID,
@@ -109,11 +120,13 @@ def _parallel(n: int, jobs: int, cache: Path, **kw: Any) -> dict[str, Any]:
         **kw,
     )
     total = time.perf_counter() - t0
+    cpu = _cpu() - c0  # the workers have been joined: their CPU time is counted
     pool = env.unwrapped.batch.source
     assert len(pool.entries) == n
     return {
         "jobs": jobs,
         "total_s": total,
+        "cpu_s": cpu,
         "median_s": None,
         "p90_s": None,
         "max_s": None,
@@ -132,8 +145,8 @@ def main(argv: list[str] | None = None) -> None:
     if args.n < 2:
         ap.error("--n must be at least 2")
     jobs = sorted({int(j) for j in args.jobs.split(",")})
-    if 1 not in jobs:
-        jobs.insert(0, 1)  # the warm row reads the serial build's folder
+    if not jobs or jobs[0] < 1:
+        ap.error("--jobs: positive process counts, e.g. 1,2")
     data: dict[str, Any] = {
         "command": _results.command("benchmarks.pool_build", argv),
         "machine": _results.machine(),
@@ -161,7 +174,8 @@ def main(argv: list[str] | None = None) -> None:
                 add("polygonal G/H, partial: cold", _serial(args.n, folders[1], **POLY))
             else:
                 add("polygonal G/H, partial: cold", _parallel(args.n, j, folders[j], **POLY))
-        add("polygonal G/H, partial: warm", _serial(args.n, folders[1], **POLY))
+        # the second build reads the folder of the first cold build
+        add("polygonal G/H, partial: warm", _serial(args.n, folders[jobs[0]], **POLY))
     data["machine"]["load_average_end"] = _results.machine()["load_average"]
     _results.write("pool_build", data, args.out, args.update_results)
 
@@ -176,10 +190,10 @@ def render(data: dict[str, Any]) -> str:
     anchor = data["rows"][0]["total_s"]
     ext = "measured" if n == target else f"extrapolated from {n}"
     lines = [
-        f"| build of {n} scenes | processes | regions computed / read | total | per scene "
-        f"(total / N) | median, p90 per scene | time in the region | {target:,} scenes "
+        f"| build of {n} scenes | processes | regions computed / read | total | CPU / wall | "
+        f"per scene (total / N) | median, p90 per scene | time in the region | {target:,} scenes "
         f"({ext}) | ratio to the anchor |",
-        "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |",
+        "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |",
     ]
     for r in data["rows"]:
         cr = "" if r["computed"] is None else f"{r['computed']} / {r['read']}"
@@ -189,6 +203,7 @@ def render(data: dict[str, Any]) -> str:
         big = f"{tot / 60:.1f} min" if tot >= 120 else f"{tot:.0f} s"
         lines.append(
             f"| {r['build']} | {r['jobs']} | {cr} | {r['total_s']:.1f} s | "
+            f"{r['cpu_s'] / r['total_s']:.2f} | "
             f"{r['total_s'] / n:.3f} s | {med} | {share} | {big} | "
             f"{r['total_s'] / anchor:.1f} |"
         )
