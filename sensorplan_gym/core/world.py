@@ -13,7 +13,9 @@ change during an episode computed once:
   core (:mod:`sensorplan_gym.core.sim`) copies a world into a sub-environment's row.
 
 Worlds are cached by :func:`sensorplan_gym.core.cache.get_world` (the cache sits above this
-module: it builds worlds, a world never reaches the cache).
+module: it builds worlds, a world never reaches the cache).  The region of a world built with
+``disk_cache=`` (scene pools do) is read from, or stored to, an on-disk cache
+(:mod:`sensorplan_gym.core.diskcache`).
 
 Target motion (``motion``)
 --------------------------
