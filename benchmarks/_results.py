@@ -38,6 +38,7 @@ NAMES = (
     "family_breakdown",
     "oracle",
     "policies",
+    "pool_build",
     "real_maps",
     "regions",
     "scaling",

@@ -16,6 +16,11 @@ settings.register_profile(
 )
 settings.load_profile("ci" if os.environ.get("CI") else "dev")
 
+# Scene pools cache their regions on disk by default (sensorplan_gym.core.diskcache): tests
+# compute every region and write nothing under the user's cache folder (the cache's own tests
+# pass a temporary folder explicitly).
+os.environ["SENSORPLAN_GYM_CACHE"] = "off"
+
 #: A small valid scene (JSON form): a 10 x 10 room, two touching obstacles,
 #: a unit-square target, a square goal and a point failure region.
 LAB: dict[str, Any] = {

@@ -7,6 +7,7 @@ import json
 from collections import OrderedDict
 from typing import TYPE_CHECKING
 
+from .diskcache import RegionCache
 from .world import World, WorldConfig
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -18,15 +19,23 @@ CACHE_SIZE = 64
 _CACHE: OrderedDict[tuple, World] = OrderedDict()
 
 
-def get_world(scene: Scene, cfg: WorldConfig, data: dict | None = None) -> World:
+def get_world(
+    scene: Scene,
+    cfg: WorldConfig,
+    data: dict | None = None,
+    *,
+    disk_cache: RegionCache | None = None,
+) -> World:
     """The cached :class:`World` for ``(scene, cfg)`` (LRU of ``CACHE_SIZE`` entries).
-    ``data``: the scene's JSON dict when the caller has it (saves a deep copy)."""
+    ``data``: the scene's JSON dict when the caller has it (saves a deep copy).
+    ``disk_cache``: where a world not in memory looks up its region before computing it
+    (:class:`~.diskcache.RegionCache`; ``None``: computed)."""
     key = (json.dumps(scene.to_dict() if data is None else data, sort_keys=True), cfg)
     w = _CACHE.get(key)
     if w is not None:
         _CACHE.move_to_end(key)
         return w
-    w = World(scene, cfg)
+    w = World(scene, cfg, disk_cache=disk_cache)
     _CACHE[key] = w
     if len(_CACHE) > CACHE_SIZE:
         _CACHE.popitem(last=False)

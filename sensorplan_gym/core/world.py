@@ -13,7 +13,9 @@ change during an episode computed once:
   core (:mod:`sensorplan_gym.core.sim`) copies a world into a sub-environment's row.
 
 Worlds are cached by :func:`sensorplan_gym.core.cache.get_world` (the cache sits above this
-module: it builds worlds, a world never reaches the cache).
+module: it builds worlds, a world never reaches the cache).  The region of a world built with
+``disk_cache=`` (scene pools do) is read from, or stored to, an on-disk cache
+(:mod:`sensorplan_gym.core.diskcache`).
 
 Target motion (``motion``)
 --------------------------
@@ -34,6 +36,7 @@ polygonal H (or the reverse) is supported (``geometry.mixed``).
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -46,6 +49,7 @@ from shapely.geometry import Point
 from geometry import Scene, SceneError, recognizable_region
 
 from .collision import sweep
+from .diskcache import RegionCache
 from .queries import aim_ok_batch, region_distance_batch
 from .scenes import BUNDLED_SCENES, bundled_scene_path, load_scene
 from .segments import (
@@ -120,7 +124,11 @@ class WorldConfig:
 class World:
     """One scene under one configuration (see the module docstring).  Treat as immutable."""
 
-    def __init__(self, scene: Scene, cfg: WorldConfig) -> None:
+    def __init__(
+        self, scene: Scene, cfg: WorldConfig, *, disk_cache: RegionCache | None = None
+    ) -> None:
+        """``disk_cache``: where the recognizable region is looked up before it is computed
+        (and stored after; :mod:`.diskcache`); ``None``: always computed."""
         cfg.validate()
         self.cfg = cfg
         sensor = scene.sensor
@@ -151,10 +159,19 @@ class World:
         # the sensor's effective reach: beams never travel farther than the room's diagonal
         self.reach = min(self.max_range, self.diameter)
 
+        args = {
+            "model": cfg.model,
+            "theta": self.theta,
+            "eps_pos": self.eps_pos,
+            "eps_aim": self.eps_aim,
+        }
         try:
-            region = recognizable_region(
-                scene, model=cfg.model, theta=self.theta, eps_pos=self.eps_pos, eps_aim=self.eps_aim
-            )
+            if disk_cache is None:
+                region = recognizable_region(scene, **args)
+            else:
+                region = disk_cache.region(
+                    scene, functools.partial(recognizable_region, scene, **args), **args
+                )
         except NotImplementedError as e:
             raise NotImplementedError(
                 f"scene {scene.name!r} with model={cfg.model!r}, motion={cfg.motion!r}: {e}"

@@ -22,6 +22,13 @@ scene : str | path | dict | geometry.Scene, default ``"lab"``
     from the start, or that contain the start are re-drawn when the pool is built).
 scene_pool_size : int, default 64 -- scenes in the ``"random"`` pool.
 scene_pool_seed : int, default 0 -- the pool's seed (disjoint seeds: disjoint splits).
+scene_pool_jobs : int | None, default None -- ``None``: pool scenes are built on first use;
+    an integer ``k``: the whole pool is built at construction in ``k`` processes
+    (:meth:`~sensorplan_gym.core.pool.ScenePool.build`; the same scenes either way).
+scene_pool_cache : bool | path | None, default None -- where pool regions are cached on disk
+    (:mod:`sensorplan_gym.core.diskcache`): ``None`` the default folder
+    (``$XDG_CACHE_HOME/sensorplan-gym``; ``SENSORPLAN_GYM_CACHE=off`` switches it off),
+    ``False`` no disk cache, a path that folder.
 min_start_distance : float | None, default None (0, or the ``difficulty``'s) -- a difficulty
     knob for ``scene="random"``: pool scenes whose start lies closer than this fraction of the
     scene diameter to the recognizable region are re-drawn (Navigate, Recognize); with
@@ -78,6 +85,7 @@ from __future__ import annotations
 
 import functools
 import math
+import os
 from typing import Any
 
 import gymnasium as gym
@@ -90,7 +98,7 @@ from ..core import fused
 from ..core.actions import make_actions
 from ..core.cache import get_world
 from ..core.observations import make_observation
-from ..core.pool import FixedScene, shared_pool
+from ..core.pool import FixedScene, check_jobs, shared_pool
 from ..core.queries import aim_ok_batch
 from ..core.rendering import HumanViewer, Renderer
 from ..core.sensor import NOISE_BOUND, RangeSensor
@@ -309,6 +317,8 @@ class SensorPlanBatch(BatchSim):
         difficulty: str | None = None,
         scene_pool_size: int = 64,
         scene_pool_seed: int = 0,
+        scene_pool_jobs: int | None = None,
+        scene_pool_cache: bool | str | os.PathLike[str] | None = None,
         max_steps: int | None = None,
         action_type: str = "continuous",
         map_ranges: bool = False,
@@ -388,6 +398,8 @@ class SensorPlanBatch(BatchSim):
         if not isinstance(min_start_distance, (int, float)) or not 0 <= min_start_distance < 1:
             raise ValueError(f"min_start_distance must be in [0, 1), got {min_start_distance!r}")
         self.min_start_distance = float(min_start_distance)
+        if not self.random and (scene_pool_jobs is not None or scene_pool_cache is not None):
+            raise ValueError("scene_pool_jobs= and scene_pool_cache= need scene='random'")
         check = functools.partial(_check, needs_start=self.needs_start)
         if self.random:
             view = family is not None and self.joint_view
@@ -404,8 +416,13 @@ class SensorPlanBatch(BatchSim):
                 scene_kwargs=dict(random_scene_kwargs or {}),
                 max_tries=max_scene_tries,
                 family=family,
+                disk_cache=scene_pool_cache,
             )
+            if scene_pool_jobs is not None:
+                check_jobs(scene_pool_jobs)
             world, start = self.source.get(0)  # unsupported configurations fail here
+            if scene_pool_jobs is not None:
+                self.source.build(jobs=scene_pool_jobs)
         else:
             sc = load_scene(scene)
             world = get_world(sc, self.cfg)
