@@ -261,8 +261,20 @@ class Sweeper:
             return out
         # all rings labelled in one batch (row by row, so as if ring by ring)
         d = np.concatenate([np.roll(v, -1, axis=0) - v for v in vs])
-        all_keys = self._label(np.concatenate(vs), table, tid, d=d)
+        flat = np.concatenate(vs)
         off = np.cumsum([0] + [len(v) for v in vs])
+        # an edge between two environment vertices far apart is on a fixed line (its key
+        # is two fixed anchors, see below): only the other edges and their neighbours are
+        # labelled (most of a shadow's boundary is the free space's)
+        fixed = self._fixed_edges(flat, off)
+        ring_of = np.repeat(np.arange(len(vs)), np.diff(off))
+        idx = np.arange(len(flat))
+        nxt = np.where(idx + 1 == off[ring_of + 1], off[ring_of], idx + 1)
+        prv = np.where(idx == off[ring_of], off[ring_of + 1] - 1, idx - 1)
+        need = ~fixed | ~fixed[nxt] | ~fixed[prv]
+        all_keys = np.full((len(flat), 2), -1, dtype=np.int64)
+        if need.any():
+            all_keys[need] = self._label(flat[need], table, tid, d=d[need])
         for r, v in enumerate(vs):
             keys = all_keys[off[r] : off[r + 1]]
             moving = (keys >= n).any(axis=1) & (keys >= 0).all(axis=1)
@@ -271,6 +283,32 @@ class Sweeper:
                 if min(kp) < 0 or min(kn) < 0 or set(kp) == set(keys[i]) or set(kn) == set(keys[i]):
                     continue
                 out.append((tuple(kp), tuple(keys[i]), tuple(kn)))
+        return out
+
+    def _fixed_edges(self, v: np.ndarray, off: np.ndarray) -> np.ndarray:
+        """(n,) bool per edge ``v[i] -> v[i + 1]`` of the closed rings ``v[off[r] :
+        off[r + 1]]``: both ends are environment vertices (within ``1e-12`` of the scene's
+        size: the shadow's overlay snap-rounds them onto ``shadow_grid``) more than
+        ``3 tol_lab`` apart.  Such an edge's line passes within ``tol_lab`` of two fixed
+        anchors that are not both within ``tol_lab`` of any one anchor, so :meth:`_label`
+        keys it by two fixed anchors (it prefers fixed ones): it does not move."""
+        env = self.env.vert
+        keys = getattr(self, "_vert_keys", None)
+        if keys is None:
+            cell = np.round(env / self.shadow_grid)
+            keys = self._vert_keys = {
+                (float(x), float(y)): i for i, (x, y) in enumerate(cell.tolist())
+            }
+        cell = np.round(v / self.shadow_grid).tolist()
+        at = np.array([keys.get((x, y), -1) for x, y in cell], dtype=np.int64)
+        ok = at >= 0
+        ok[ok] = np.abs(env[at[ok]] - v[ok]).max(axis=1) <= 1e-12 * self.env.scale
+        ring_of = np.repeat(np.arange(len(off) - 1), np.diff(off))
+        idx = np.arange(len(v))
+        nxt = np.where(idx + 1 == off[ring_of + 1], off[ring_of], idx + 1)
+        both = ok & ok[nxt]
+        out = np.zeros(len(v), dtype=bool)
+        out[both] = np.abs(env[at[both]] - env[at[nxt[both]]]).max(axis=1) > 3.0 * self.tol_lab
         return out
 
     def _label(
@@ -876,18 +914,22 @@ class Sweeper:
         """Fractions along each edge (E, T, K) between consecutive crossings of the
         lines that can bound a visible beam: through a convex obstacle corner and a
         target vertex, or through two convex obstacle corners.  Between two such
-        crossings blindness along the edge does not change."""
-        b, i, j = self._corners_and_tangents()
-        if len(b) == 0:
+        crossings blindness along the edge does not change.
+
+        Only the corners that see K count, and of the lines through two corners only
+        those that meet K (:meth:`_corners_and_tangents`): a beam from p into K that a
+        corner bounds runs on from the corner into K unobstructed.  The other lines
+        cannot change what p sees of the target, so dropping them only merges intervals
+        on which blindness is constant anyway."""
+        if not self.env.reflex.any():
             return np.full(vs.shape[:-1] + (0,), np.nan)
+        b, bp, bn, i, j = self._corners_and_tangents()
         a = self.ring0[None, None, :, :] + (q0 + ts[..., None] * dq)[..., None, :]  # (E, T, m, 2)
         w = a[..., None, :, :] - b[None, None, :, None, :]  # (E, T, R, m, 2)
         rel = b[None, None, :, None, :] - vs[..., None, None, :]
         dd = d[..., None, None, :]
         # only lines tangent to the obstacle at b can bound a beam
-        bp = self.env.vert_prev[self.env.reflex][None, None, :, None, :] - b[None, None, :, None, :]
-        bn = self.env.vert_next[self.env.reflex][None, None, :, None, :] - b[None, None, :, None, :]
-        tangent = _cross(w, bp) * _cross(w, bn) >= 0
+        tangent = _cross(w, bp[None, None, :, None, :]) * _cross(w, bn[None, None, :, None, :]) >= 0
         with np.errstate(divide="ignore", invalid="ignore"):
             s1 = np.where(tangent, _cross(rel, w) / _cross(dd, w), np.nan)
             s1 = s1.reshape(vs.shape[:-1] + (-1,))
@@ -899,23 +941,58 @@ class Sweeper:
             wt = (self.ring0[jj] - self.ring0[ii])[None, None]
             relt = a[..., ii, :] - vs[..., None, :]
             s3 = _cross(relt, wt) / _cross(d[..., None, :], wt)
-        return _between(np.concatenate([s1, s2, s3], axis=-1))
+            # the free space's boundary: a probe lands in every piece of the edge that runs
+            # through an obstacle (off the map: not blind), as the lines dropped above
+            # happened to make it land there
+            sg = self.env.seg
+            s0, sd = sg[:, :2], sg[:, 2:] - sg[:, :2]
+            rel4 = s0 - vs[..., None, :]
+            den = _cross(d[..., None, :], sd)
+            s4 = _cross(rel4, sd) / den
+            u4 = _cross(rel4, d[..., None, :]) / den
+            s4 = np.where((u4 >= 0.0) & (u4 <= 1.0), s4, np.nan)
+        return _between(np.concatenate([s1, s2, s3, s4], axis=-1))
 
-    def _corners_and_tangents(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Convex obstacle corners, and the pairs (i, j) of them whose joining line is
-        tangent to the obstacles at both (cached)."""
+    def _corners_and_tangents(self) -> tuple[np.ndarray, ...]:
+        """Convex obstacle corners that see K, their edge vectors to the previous and
+        next boundary vertex, and the pairs (i, j) of them whose joining line is tangent
+        to the obstacles at both and meets K (cached; "see" and "meet" within 1e-6 of the
+        scene's size, generous: a corner too many only adds probes).  K is obstacle-free
+        and holds every A_q, so a corner that sees no point of K never grazes a beam from
+        a placement into the target."""
         got = getattr(self, "_tangents", None)
         if got is None:
-            b = self.env.vert[self.env.reflex]
-            bp = self.env.vert_prev[self.env.reflex] - b
-            bn = self.env.vert_next[self.env.reflex] - b
+            env = self.env
+            b = env.vert[env.reflex]
+            bp = env.vert_prev[env.reflex] - b
+            bn = env.vert_next[env.reflex] - b
+            sees = self._sees_hull(b)
+            b, bp, bn = b[sees], bp[sees], bn[sees]
             i, j = np.triu_indices(len(b), 1)
             w = b[j] - b[i]
             ok = (_cross(w, bp[i]) * _cross(w, bn[i]) >= 0) & (
                 _cross(w, bp[j]) * _cross(w, bn[j]) >= 0
             )
-            got = self._tangents = (b, i[ok], j[ok])
+            i, j = i[ok], j[ok]
+            if len(i):  # the line through the two corners meets K
+                u = w[ok] / np.hypot(w[ok, 0], w[ok, 1])[:, None]
+                r = 4.0 * env.scale  # both corners and K lie within the scene's size
+                lines = shapely.linestrings(np.stack([b[i] - r * u, b[i] + r * u], axis=1))
+                near = shapely.dwithin(lines, self._hull_poly, 1e-6 * env.scale)
+                i, j = i[near], j[near]
+            got = self._tangents = (b, bp, bn, i, j)
         return got
+
+    def _sees_hull(self, pts: np.ndarray) -> np.ndarray:
+        """(n,) bool: does each point of the free space's boundary see some point of K
+        (is it within 1e-6 of the scene's size of K or of the weak visibility region of
+        K's outline)?"""
+        if len(pts) == 0:
+            return np.zeros(0, dtype=bool)
+        ring = self.hull[::-1]  # clockwise: a hole of the domain
+        seen = weak_visibility(self.env, ring, np.ones(len(ring), dtype=bool))
+        seen = shapely.union(seen, self._hull_poly)
+        return shapely.dwithin(seen, shapely.points(pts), 1e-6 * self.env.scale)
 
     def _valid_many(self, vs: np.ndarray, ve: np.ndarray, ts: np.ndarray, q0, dq) -> np.ndarray:
         """(E, T) bool: the traced edge is a shadow edge at that time (exact point

@@ -95,3 +95,65 @@ def test_two_round_probing_equals_testing_every_probe(monkeypatch) -> None:
         assert np.array_equal(got, every)
         by_second += int((first & ~every).sum())
     assert by_second > 0  # not vacuous: the second round decides some of them
+
+
+def _unfiltered(sw: S.Sweeper) -> tuple[np.ndarray, ...]:
+    """Every convex corner, and every pair tangent at both (no "sees K" filter)."""
+    env = sw.env
+    b = env.vert[env.reflex]
+    bp = env.vert_prev[env.reflex] - b
+    bn = env.vert_next[env.reflex] - b
+    i, j = np.triu_indices(len(b), 1)
+    w = b[j] - b[i]
+    ok = (S._cross(w, bp[i]) * S._cross(w, bn[i]) >= 0) & (
+        S._cross(w, bp[j]) * S._cross(w, bn[j]) >= 0
+    )
+    return b, bp, bn, i[ok], j[ok]
+
+
+def test_probing_only_lines_into_k_equals_probing_all(monkeypatch) -> None:
+    """The corners that do not see K and the corner pairs whose line misses K are not
+    probed between: the traced edges' validity is the same as with all of them."""
+    sw = _sweeper(monkeypatch)
+    full = _unfiltered(sw)
+    got = sw._corners_and_tangents()
+    assert len(got[0]) < len(full[0]) and len(got[3]) < len(full[3])  # not vacuous
+    keys = [np.asarray(k) for k in sw._frames]
+    checked = 0
+    for q0, q1 in zip(keys[:-1], keys[1:], strict=True):
+        dq = q1 - q0
+        edges = sw._edges(*sw.shadow(q0))
+        if not edges or not np.hypot(*dq) > 0:
+            continue
+        ts = np.broadcast_to(np.linspace(0.0, 1.0, 9), (len(edges), 9))
+        vs, ve = sw._ends_many(edges, ts, q0, dq)
+        filtered = sw._valid_many(vs, ve, ts, q0, dq)
+        monkeypatch.setattr(sw, "_tangents", full)
+        every = sw._valid_many(vs, ve, ts, q0, dq)
+        monkeypatch.setattr(sw, "_tangents", got)
+        assert np.array_equal(filtered, every)
+        checked += filtered.size
+    assert checked > 0
+
+
+def test_skipping_fixed_edges_keeps_the_labels(monkeypatch) -> None:
+    """Edges between two environment vertices are not labelled: the moving edges and
+    their neighbours' keys are those of labelling every edge."""
+    sw = _sweeper(monkeypatch)
+    skipped = 0
+    for key in list(sw._frames)[:8]:
+        shadow, table, tid = sw.shadow(np.asarray(key))
+        fast = sw._edges(shadow, table, tid)
+        rings = S._rings(shapely.orient_polygons(shadow, exterior_cw=False))
+        vs = [
+            v
+            for r in rings
+            if len(v := S._drop_short(np.asarray(r.coords)[:-1, :2], sw.tol_lab)) >= 3
+        ]
+        off = np.cumsum([0] + [len(v) for v in vs])
+        skipped += int(sw._fixed_edges(np.concatenate(vs), off).sum())
+        monkeypatch.setattr(sw, "_fixed_edges", lambda v, off: np.zeros(len(v), dtype=bool))
+        slow = sw._edges(shadow, table, tid)
+        monkeypatch.delattr(sw, "_fixed_edges")
+        assert fast == slow
+    assert skipped > 0
