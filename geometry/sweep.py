@@ -238,7 +238,9 @@ class Sweeper:
         if not wanted.any():
             shadow = shapely.difference(self.free, area, grid_size=g)
         else:
-            reg = weak_visibility(self.env, ring[::-1], np.roll(wanted[::-1], -1), self.eps_aim)
+            reg = weak_visibility(
+                self.env, ring[::-1], np.roll(wanted[::-1], -1), self.eps_aim, self._anchors()
+            )
             # areal(): snap-rounding collapses slivers of the union narrower than the grid
             # into lines, and a snap-rounded overlay refuses mixed-dimension input
             seen = areal(shapely.union(reg, area, grid_size=g))
@@ -819,7 +821,9 @@ class Sweeper:
         parts = shapely.get_parts(core)
         core = parts[np.argmax(shapely.area(parts))]
         ring = np.asarray(shapely.orient_polygons(core, exterior_cw=True).exterior.coords)[:-1]
-        reg = weak_visibility(self.env, ring, np.ones(len(ring), dtype=bool), self.eps_aim)
+        reg = weak_visibility(
+            self.env, ring, np.ones(len(ring), dtype=bool), self.eps_aim, self._anchors()
+        )
         g = self.shadow_grid  # as in shadow(): the region's hole nearly coincides with core
         seen = areal(shapely.union(reg, core, grid_size=g))
         return polygonal(shapely.difference(self.free, seen, grid_size=g))
@@ -963,11 +967,10 @@ class Sweeper:
         got = getattr(self, "_tangents", None)
         if got is None:
             env = self.env
-            b = env.vert[env.reflex]
-            bp = env.vert_prev[env.reflex] - b
-            bn = env.vert_next[env.reflex] - b
-            sees = self._sees_hull(b)
-            b, bp, bn = b[sees], bp[sees], bn[sees]
+            sees = self._anchors()
+            b = env.vert[sees]
+            bp = env.vert_prev[sees] - b
+            bn = env.vert_next[sees] - b
             i, j = np.triu_indices(len(b), 1)
             w = b[j] - b[i]
             ok = (_cross(w, bp[i]) * _cross(w, bn[i]) >= 0) & (
@@ -983,16 +986,25 @@ class Sweeper:
             got = self._tangents = (b, bp, bn, i, j)
         return got
 
-    def _sees_hull(self, pts: np.ndarray) -> np.ndarray:
-        """(n,) bool: does each point of the free space's boundary see some point of K
-        (is it within 1e-6 of the scene's size of K or of the weak visibility region of
-        K's outline)?"""
-        if len(pts) == 0:
-            return np.zeros(0, dtype=bool)
-        ring = self.hull[::-1]  # clockwise: a hole of the domain
-        seen = weak_visibility(self.env, ring, np.ones(len(ring), dtype=bool))
-        seen = shapely.union(seen, self._hull_poly)
-        return shapely.dwithin(seen, shapely.points(pts), 1e-6 * self.env.scale)
+    def _anchors(self) -> np.ndarray:
+        """(len(env.vert),) bool: the convex obstacle corners (reflex vertices of the free
+        space) that see some point of K: within 1e-6 of the scene's size of K or of the
+        weak visibility region of K's outline (cached).  K holds every A_q, so the other
+        corners see no target: they are no grazing anchors of any stationary shadow
+        (:func:`~geometry.weak.weak_visibility`'s ``grazing``) and bound no beam into it."""
+        got = getattr(self, "_anchor_mask", None)
+        if got is None:
+            env = self.env
+            got = np.zeros(len(env.vert), dtype=bool)
+            idx = np.flatnonzero(env.reflex)
+            if len(idx):
+                ring = self.hull[::-1]  # clockwise: a hole of the domain
+                seen = weak_visibility(env, ring, np.ones(len(ring), dtype=bool))
+                seen = shapely.union(seen, self._hull_poly)
+                pts = shapely.points(env.vert[idx])
+                got[idx] = shapely.dwithin(seen, pts, 1e-6 * env.scale)
+            self._anchor_mask = got
+        return got
 
     def _valid_many(self, vs: np.ndarray, ve: np.ndarray, ts: np.ndarray, q0, dq) -> np.ndarray:
         """(E, T) bool: the traced edge is a shadow edge at that time (exact point
