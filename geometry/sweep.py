@@ -77,6 +77,10 @@ GRID_BITS = 40
 #: see :meth:`Sweeper.shadow`.
 SHADOW_BITS = 8
 
+#: The bisection of a traced edge's death time tests this many levels of its binary
+#: tree of midpoints in one batch: see :meth:`Sweeper._bisect`.
+BISECT_LEVELS = 5
+
 __all__ = ["QueryTimeout", "Sweeper", "star_center", "swept_shadows"]
 
 
@@ -844,13 +848,7 @@ class Sweeper:
             t_ok = ts[n_ok[dying] - 1].astype(float)
             t_bad = ts[n_ok[dying]].astype(float)
             sub = [edges[i] for i in dying]
-            for _ in range(self.bisect_steps):
-                tm = 0.5 * (t_ok + t_bad)
-                a, b = self._ends_many(sub, tm[:, None], q0, dq)
-                good = self._valid_many(a, b, tm[:, None], q0, dq)[:, 0]
-                t_ok = np.where(good, tm, t_ok)
-                t_bad = np.where(good, t_bad, tm)
-            t_end[dying] = t_ok
+            t_end[dying] = self._bisect(sub, t_ok, t_bad, q0, dq)
         # the ends on the grid are vs, ve; those at the death times in one batch
         if len(dying):
             da, db = self._ends_many([edges[i] for i in dying], t_end[dying][:, None], q0, dq)
@@ -875,6 +873,42 @@ class Sweeper:
         if bad.any():
             polys[bad] = shapely.make_valid(polys[bad])
         return list(polys), ends
+
+    def _bisect(self, edges: list, t_ok: np.ndarray, t_bad: np.ndarray, q0, dq) -> np.ndarray:
+        """``bisect_steps`` bisection steps on the death time of each edge (valid at
+        ``t_ok``, not at ``t_bad``): the last time found valid.
+
+        The steps run in rounds of up to ``BISECT_LEVELS``: a round tests, in one batch,
+        the midpoints of every interval that the next levels of the bisection can reach
+        (2**levels - 1 per edge), then follows each edge's path through them.  The times
+        tested on the path and their outcomes are those of the steps one at a time
+        (validity is decided row by row), so the answer is the same; the exact point
+        test runs once per round instead of once per step."""
+        rows = np.arange(len(edges))
+        steps = self.bisect_steps
+        while steps > 0:
+            levels = min(BISECT_LEVELS, steps)
+            lo, hi = t_ok[:, None], t_bad[:, None]
+            mids = []
+            for _ in range(levels):  # node j's children: 2j (not valid), 2j + 1 (valid)
+                mid = 0.5 * (lo + hi)
+                mids.append(mid)
+                lo = np.stack([lo, mid], axis=-1).reshape(len(edges), -1)
+                hi = np.stack([mid, hi], axis=-1).reshape(len(edges), -1)
+            tm = np.concatenate(mids, axis=1)  # (E, 2**levels - 1), level by level
+            a, b = self._ends_many(edges, tm, q0, dq)
+            good = self._valid_many(a, b, tm, q0, dq)
+            node = np.zeros(len(edges), dtype=np.int64)
+            first = 0
+            for level in range(levels):
+                col = first + node
+                g, t = good[rows, col], tm[rows, col]
+                t_ok = np.where(g, t, t_ok)
+                t_bad = np.where(g, t_bad, t)
+                first += 2**level
+                node = 2 * node + g
+            steps -= levels
+        return t_ok
 
     def _ends(self, edge, ts: np.ndarray, q0, dq) -> tuple[np.ndarray, np.ndarray]:
         """Start and end points of one shadow edge at times ``ts``."""
