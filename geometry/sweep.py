@@ -796,10 +796,13 @@ class Sweeper:
             if upper is None:
                 new = True
             else:
-                known = shapely.union(frame(a)[0], frame(b)[0])
                 parts = shapely.get_parts(upper)
                 parts = parts[~shapely.is_empty(parts)]  # an empty shadow is no new component
-                new = bool((~shapely.intersects(parts, known)).any()) if len(parts) else False
+                # meets the union of the two shadows = meets one of them (no overlay)
+                meets = np.zeros(len(parts), dtype=bool)
+                for k in (frame(a)[0], frame(b)[0]):
+                    meets |= shapely.intersects(parts, k)
+                new = bool((~meets).any())
             if new:
                 m = 0.5 * (a + b)
                 frame(m)
