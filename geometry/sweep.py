@@ -1013,6 +1013,8 @@ class Sweeper:
             ok = (_cross(w, bp[i]) * _cross(w, bn[i]) >= 0) & (
                 _cross(w, bp[j]) * _cross(w, bn[j]) >= 0
             )
+            # coincident corners (a pinch) span no line: their crossings are NaN anyway
+            ok &= np.hypot(w[:, 0], w[:, 1]) > 0
             i, j = i[ok], j[ok]
             if len(i):  # the line through the two corners meets K
                 u = w[ok] / np.hypot(w[ok, 0], w[ok, 1])[:, None]
