@@ -79,7 +79,7 @@ SHADOW_BITS = 8
 
 #: The bisection of a traced edge's death time tests this many levels of its binary
 #: tree of midpoints in one batch: see :meth:`Sweeper._bisect`.
-BISECT_LEVELS = 5
+BISECT_LEVELS = 3
 
 __all__ = ["QueryTimeout", "Sweeper", "star_center", "swept_shadows"]
 
