@@ -1163,8 +1163,12 @@ def _drop_short(v: np.ndarray, length: float) -> np.ndarray:
         keep = list(range(len(v)))
     else:
         keep = [0]
+        long_step = step.tolist()  # right after a kept vertex the test is the step's
         for i in range(1, len(v)):
-            if np.abs(v[i] - v[keep[-1]]).max() >= length:
+            if keep[-1] == i - 1:
+                if long_step[i - 1]:
+                    keep.append(i)
+            elif np.abs(v[i] - v[keep[-1]]).max() >= length:
                 keep.append(i)
     while len(keep) > 1 and np.abs(v[keep[-1]] - v[0]).max() < length:
         keep.pop()
