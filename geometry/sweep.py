@@ -164,6 +164,8 @@ class Sweeper:
         self.grid = snap_grid(self.env.scale)
         #: snap-rounding grid of the stationary shadows (scene units, a power of two)
         self.shadow_grid = math.ldexp(self.grid, -SHADOW_BITS)
+        #: the ``grazing`` anchors of the stationary shadows (None: all; same answer)
+        self._grazing: np.ndarray | None = None
 
     # ------------------------------------------------------------------ anchors
     def pos(self, ids: np.ndarray, q: np.ndarray) -> np.ndarray:
@@ -243,7 +245,7 @@ class Sweeper:
             shadow = shapely.difference(self.free, area, grid_size=g)
         else:
             reg = weak_visibility(
-                self.env, ring[::-1], np.roll(wanted[::-1], -1), self.eps_aim, self._anchors()
+                self.env, ring[::-1], np.roll(wanted[::-1], -1), self.eps_aim, self._grazing
             )
             # areal(): snap-rounding collapses slivers of the union narrower than the grid
             # into lines, and a snap-rounded overlay refuses mixed-dimension input
@@ -530,6 +532,9 @@ class Sweeper:
         """Pieces whose union is the union of the shadows S(q) for q on the
         segment ``q0 -> q1``, and counters (samples, traced edges, refinements)."""
         q0, q1 = np.asarray(q0, dtype=float), np.asarray(q1, dtype=float)
+        # the shadows of a sweep skip the corners that see no point of K (one weak
+        # visibility of K, paid back over the samples; a lone shadow does without)
+        self._grazing = self._anchors()
         dq = q1 - q0
         stats = {"samples": 0, "edges": 0, "refined": 0}
         frames: dict[float, tuple] = {}

@@ -181,3 +181,18 @@ def test_batched_bisection_equals_step_by_step(monkeypatch) -> None:
         assert np.array_equal(got, t_ok)
         moved += int(((got > 0) & (got < 0.99)).sum())
     assert moved > 0  # not vacuous: some edges die inside the interval
+
+
+def test_skipping_corners_blind_to_k_keeps_the_shadows(monkeypatch) -> None:
+    """The stationary shadows of a sweep skip the grazing anchors that see no point of K:
+    the shadows are those with every anchor (bit for bit)."""
+    sw = _sweeper(monkeypatch)
+    mask = sw._anchors()
+    assert 0 < mask.sum() < sw.env.reflex.sum()  # not vacuous: some corners are skipped
+    for key in list(sw._frames)[:8]:
+        q = np.asarray(key)
+        sw._grazing = mask
+        fast = sw.shadow(q)[0]
+        sw._grazing = None
+        slow = sw.shadow(q)[0]
+        assert shapely.equals_exact(fast, slow, 0.0)
