@@ -665,7 +665,8 @@ class Sweeper:
         if len(t) == 0:
             return t
         keep = self._tangent_events(xa, ta, la, w, lb, pb, b, ii, kk)
-        keep &= shapely.covers(self._free_near(), shapely.linestrings(segs))
+        idx = np.flatnonzero(keep)  # the covering test only where the tangency holds
+        keep[idx] = shapely.covers(self._free_near(), shapely.linestrings(segs[idx]))
         cut = np.flatnonzero(xa >= self.m)  # ends of wanted pieces: on their edge then?
         if len(cut):
             k = xa[cut] - self.m
