@@ -77,6 +77,10 @@ GRID_BITS = 40
 #: see :meth:`Sweeper.shadow`.
 SHADOW_BITS = 8
 
+#: The bisection of a traced edge's death time tests this many levels of its binary
+#: tree of midpoints in one batch: see :meth:`Sweeper._bisect`.
+BISECT_LEVELS = 3
+
 __all__ = ["QueryTimeout", "Sweeper", "star_center", "swept_shadows"]
 
 
@@ -160,6 +164,8 @@ class Sweeper:
         self.grid = snap_grid(self.env.scale)
         #: snap-rounding grid of the stationary shadows (scene units, a power of two)
         self.shadow_grid = math.ldexp(self.grid, -SHADOW_BITS)
+        #: the ``grazing`` anchors of the stationary shadows (None: all; same answer)
+        self._grazing: np.ndarray | None = None
 
     # ------------------------------------------------------------------ anchors
     def pos(self, ids: np.ndarray, q: np.ndarray) -> np.ndarray:
@@ -238,7 +244,9 @@ class Sweeper:
         if not wanted.any():
             shadow = shapely.difference(self.free, area, grid_size=g)
         else:
-            reg = weak_visibility(self.env, ring[::-1], np.roll(wanted[::-1], -1), self.eps_aim)
+            reg = weak_visibility(
+                self.env, ring[::-1], np.roll(wanted[::-1], -1), self.eps_aim, self._grazing
+            )
             # areal(): snap-rounding collapses slivers of the union narrower than the grid
             # into lines, and a snap-rounded overlay refuses mixed-dimension input
             seen = areal(shapely.union(reg, area, grid_size=g))
@@ -261,8 +269,20 @@ class Sweeper:
             return out
         # all rings labelled in one batch (row by row, so as if ring by ring)
         d = np.concatenate([np.roll(v, -1, axis=0) - v for v in vs])
-        all_keys = self._label(np.concatenate(vs), table, tid, d=d)
+        flat = np.concatenate(vs)
         off = np.cumsum([0] + [len(v) for v in vs])
+        # an edge between two environment vertices far apart is on a fixed line (its key
+        # is two fixed anchors, see below): only the other edges and their neighbours are
+        # labelled (most of a shadow's boundary is the free space's)
+        fixed = self._fixed_edges(flat, off)
+        ring_of = np.repeat(np.arange(len(vs)), np.diff(off))
+        idx = np.arange(len(flat))
+        nxt = np.where(idx + 1 == off[ring_of + 1], off[ring_of], idx + 1)
+        prv = np.where(idx == off[ring_of], off[ring_of + 1] - 1, idx - 1)
+        need = ~fixed | ~fixed[nxt] | ~fixed[prv]
+        all_keys = np.full((len(flat), 2), -1, dtype=np.int64)
+        if need.any():
+            all_keys[need] = self._label(flat[need], table, tid, d=d[need])
         for r, v in enumerate(vs):
             keys = all_keys[off[r] : off[r + 1]]
             moving = (keys >= n).any(axis=1) & (keys >= 0).all(axis=1)
@@ -271,6 +291,32 @@ class Sweeper:
                 if min(kp) < 0 or min(kn) < 0 or set(kp) == set(keys[i]) or set(kn) == set(keys[i]):
                     continue
                 out.append((tuple(kp), tuple(keys[i]), tuple(kn)))
+        return out
+
+    def _fixed_edges(self, v: np.ndarray, off: np.ndarray) -> np.ndarray:
+        """(n,) bool per edge ``v[i] -> v[i + 1]`` of the closed rings ``v[off[r] :
+        off[r + 1]]``: both ends are environment vertices (within ``1e-12`` of the scene's
+        size: the shadow's overlay snap-rounds them onto ``shadow_grid``) more than
+        ``3 tol_lab`` apart.  Such an edge's line passes within ``tol_lab`` of two fixed
+        anchors that are not both within ``tol_lab`` of any one anchor, so :meth:`_label`
+        keys it by two fixed anchors (it prefers fixed ones): it does not move."""
+        env = self.env.vert
+        keys = getattr(self, "_vert_keys", None)
+        if keys is None:
+            cell = np.round(env / self.shadow_grid)
+            keys = self._vert_keys = {
+                (float(x), float(y)): i for i, (x, y) in enumerate(cell.tolist())
+            }
+        cell = np.round(v / self.shadow_grid).tolist()
+        at = np.array([keys.get((x, y), -1) for x, y in cell], dtype=np.int64)
+        ok = at >= 0
+        ok[ok] = np.abs(env[at[ok]] - v[ok]).max(axis=1) <= 1e-12 * self.env.scale
+        ring_of = np.repeat(np.arange(len(off) - 1), np.diff(off))
+        idx = np.arange(len(v))
+        nxt = np.where(idx + 1 == off[ring_of + 1], off[ring_of], idx + 1)
+        both = ok & ok[nxt]
+        out = np.zeros(len(v), dtype=bool)
+        out[both] = np.abs(env[at[both]] - env[at[nxt[both]]]).max(axis=1) > 3.0 * self.tol_lab
         return out
 
     def _label(
@@ -486,6 +532,9 @@ class Sweeper:
         """Pieces whose union is the union of the shadows S(q) for q on the
         segment ``q0 -> q1``, and counters (samples, traced edges, refinements)."""
         q0, q1 = np.asarray(q0, dtype=float), np.asarray(q1, dtype=float)
+        # the shadows of a sweep skip the corners that see no point of K (one weak
+        # visibility of K, paid back over the samples; a lone shadow does without)
+        self._grazing = self._anchors()
         dq = q1 - q0
         stats = {"samples": 0, "edges": 0, "refined": 0}
         frames: dict[float, tuple] = {}
@@ -616,7 +665,8 @@ class Sweeper:
         if len(t) == 0:
             return t
         keep = self._tangent_events(xa, ta, la, w, lb, pb, b, ii, kk)
-        keep &= shapely.covers(self._free_near(), shapely.linestrings(segs))
+        idx = np.flatnonzero(keep)  # the covering test only where the tangency holds
+        keep[idx] = shapely.covers(self._free_near(), shapely.linestrings(segs[idx]))
         cut = np.flatnonzero(xa >= self.m)  # ends of wanted pieces: on their edge then?
         if len(cut):
             k = xa[cut] - self.m
@@ -752,10 +802,13 @@ class Sweeper:
             if upper is None:
                 new = True
             else:
-                known = shapely.union(frame(a)[0], frame(b)[0])
                 parts = shapely.get_parts(upper)
                 parts = parts[~shapely.is_empty(parts)]  # an empty shadow is no new component
-                new = bool((~shapely.intersects(parts, known)).any()) if len(parts) else False
+                # meets the union of the two shadows = meets one of them (no overlay)
+                meets = np.zeros(len(parts), dtype=bool)
+                for k in (frame(a)[0], frame(b)[0]):
+                    meets |= shapely.intersects(parts, k)
+                new = bool((~meets).any())
             if new:
                 m = 0.5 * (a + b)
                 frame(m)
@@ -781,7 +834,9 @@ class Sweeper:
         parts = shapely.get_parts(core)
         core = parts[np.argmax(shapely.area(parts))]
         ring = np.asarray(shapely.orient_polygons(core, exterior_cw=True).exterior.coords)[:-1]
-        reg = weak_visibility(self.env, ring, np.ones(len(ring), dtype=bool), self.eps_aim)
+        reg = weak_visibility(
+            self.env, ring, np.ones(len(ring), dtype=bool), self.eps_aim, self._anchors()
+        )
         g = self.shadow_grid  # as in shadow(): the region's hole nearly coincides with core
         seen = areal(shapely.union(reg, core, grid_size=g))
         return polygonal(shapely.difference(self.free, seen, grid_size=g))
@@ -802,13 +857,7 @@ class Sweeper:
             t_ok = ts[n_ok[dying] - 1].astype(float)
             t_bad = ts[n_ok[dying]].astype(float)
             sub = [edges[i] for i in dying]
-            for _ in range(self.bisect_steps):
-                tm = 0.5 * (t_ok + t_bad)
-                a, b = self._ends_many(sub, tm[:, None], q0, dq)
-                good = self._valid_many(a, b, tm[:, None], q0, dq)[:, 0]
-                t_ok = np.where(good, tm, t_ok)
-                t_bad = np.where(good, t_bad, tm)
-            t_end[dying] = t_ok
+            t_end[dying] = self._bisect(sub, t_ok, t_bad, q0, dq)
         # the ends on the grid are vs, ve; those at the death times in one batch
         if len(dying):
             da, db = self._ends_many([edges[i] for i in dying], t_end[dying][:, None], q0, dq)
@@ -833,6 +882,42 @@ class Sweeper:
         if bad.any():
             polys[bad] = shapely.make_valid(polys[bad])
         return list(polys), ends
+
+    def _bisect(self, edges: list, t_ok: np.ndarray, t_bad: np.ndarray, q0, dq) -> np.ndarray:
+        """``bisect_steps`` bisection steps on the death time of each edge (valid at
+        ``t_ok``, not at ``t_bad``): the last time found valid.
+
+        The steps run in rounds of up to ``BISECT_LEVELS``: a round tests, in one batch,
+        the midpoints of every interval that the next levels of the bisection can reach
+        (2**levels - 1 per edge), then follows each edge's path through them.  The times
+        tested on the path and their outcomes are those of the steps one at a time
+        (validity is decided row by row), so the answer is the same; the exact point
+        test runs once per round instead of once per step."""
+        rows = np.arange(len(edges))
+        steps = self.bisect_steps
+        while steps > 0:
+            levels = min(BISECT_LEVELS, steps)
+            lo, hi = t_ok[:, None], t_bad[:, None]
+            mids = []
+            for _ in range(levels):  # node j's children: 2j (not valid), 2j + 1 (valid)
+                mid = 0.5 * (lo + hi)
+                mids.append(mid)
+                lo = np.stack([lo, mid], axis=-1).reshape(len(edges), -1)
+                hi = np.stack([mid, hi], axis=-1).reshape(len(edges), -1)
+            tm = np.concatenate(mids, axis=1)  # (E, 2**levels - 1), level by level
+            a, b = self._ends_many(edges, tm, q0, dq)
+            good = self._valid_many(a, b, tm, q0, dq)
+            node = np.zeros(len(edges), dtype=np.int64)
+            first = 0
+            for level in range(levels):
+                col = first + node
+                g, t = good[rows, col], tm[rows, col]
+                t_ok = np.where(g, t, t_ok)
+                t_bad = np.where(g, t_bad, t)
+                first += 2**level
+                node = 2 * node + g
+            steps -= levels
+        return t_ok
 
     def _ends(self, edge, ts: np.ndarray, q0, dq) -> tuple[np.ndarray, np.ndarray]:
         """Start and end points of one shadow edge at times ``ts``."""
@@ -876,18 +961,22 @@ class Sweeper:
         """Fractions along each edge (E, T, K) between consecutive crossings of the
         lines that can bound a visible beam: through a convex obstacle corner and a
         target vertex, or through two convex obstacle corners.  Between two such
-        crossings blindness along the edge does not change."""
-        b, i, j = self._corners_and_tangents()
-        if len(b) == 0:
+        crossings blindness along the edge does not change.
+
+        Only the corners that see K count, and of the lines through two corners only
+        those that meet K (:meth:`_corners_and_tangents`): a beam from p into K that a
+        corner bounds runs on from the corner into K unobstructed.  The other lines
+        cannot change what p sees of the target, so dropping them only merges intervals
+        on which blindness is constant anyway."""
+        if not self.env.reflex.any():
             return np.full(vs.shape[:-1] + (0,), np.nan)
+        b, bp, bn, i, j = self._corners_and_tangents()
         a = self.ring0[None, None, :, :] + (q0 + ts[..., None] * dq)[..., None, :]  # (E, T, m, 2)
         w = a[..., None, :, :] - b[None, None, :, None, :]  # (E, T, R, m, 2)
         rel = b[None, None, :, None, :] - vs[..., None, None, :]
         dd = d[..., None, None, :]
         # only lines tangent to the obstacle at b can bound a beam
-        bp = self.env.vert_prev[self.env.reflex][None, None, :, None, :] - b[None, None, :, None, :]
-        bn = self.env.vert_next[self.env.reflex][None, None, :, None, :] - b[None, None, :, None, :]
-        tangent = _cross(w, bp) * _cross(w, bn) >= 0
+        tangent = _cross(w, bp[None, None, :, None, :]) * _cross(w, bn[None, None, :, None, :]) >= 0
         with np.errstate(divide="ignore", invalid="ignore"):
             s1 = np.where(tangent, _cross(rel, w) / _cross(dd, w), np.nan)
             s1 = s1.reshape(vs.shape[:-1] + (-1,))
@@ -899,22 +988,67 @@ class Sweeper:
             wt = (self.ring0[jj] - self.ring0[ii])[None, None]
             relt = a[..., ii, :] - vs[..., None, :]
             s3 = _cross(relt, wt) / _cross(d[..., None, :], wt)
-        return _between(np.concatenate([s1, s2, s3], axis=-1))
+            # the free space's boundary: a probe lands in every piece of the edge that runs
+            # through an obstacle (off the map: not blind), as the lines dropped above
+            # happened to make it land there
+            sg = self.env.seg
+            s0, sd = sg[:, :2], sg[:, 2:] - sg[:, :2]
+            rel4 = s0 - vs[..., None, :]
+            den = _cross(d[..., None, :], sd)
+            s4 = _cross(rel4, sd) / den
+            u4 = _cross(rel4, d[..., None, :]) / den
+            s4 = np.where((u4 >= 0.0) & (u4 <= 1.0), s4, np.nan)
+        return _between(np.concatenate([s1, s2, s3, s4], axis=-1))
 
-    def _corners_and_tangents(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Convex obstacle corners, and the pairs (i, j) of them whose joining line is
-        tangent to the obstacles at both (cached)."""
+    def _corners_and_tangents(self) -> tuple[np.ndarray, ...]:
+        """Convex obstacle corners that see K, their edge vectors to the previous and
+        next boundary vertex, and the pairs (i, j) of them whose joining line is tangent
+        to the obstacles at both and meets K (cached; "see" and "meet" within 1e-6 of the
+        scene's size, generous: a corner too many only adds probes).  K is obstacle-free
+        and holds every A_q, so a corner that sees no point of K never grazes a beam from
+        a placement into the target."""
         got = getattr(self, "_tangents", None)
         if got is None:
-            b = self.env.vert[self.env.reflex]
-            bp = self.env.vert_prev[self.env.reflex] - b
-            bn = self.env.vert_next[self.env.reflex] - b
+            env = self.env
+            sees = self._anchors()
+            b = env.vert[sees]
+            bp = env.vert_prev[sees] - b
+            bn = env.vert_next[sees] - b
             i, j = np.triu_indices(len(b), 1)
             w = b[j] - b[i]
             ok = (_cross(w, bp[i]) * _cross(w, bn[i]) >= 0) & (
                 _cross(w, bp[j]) * _cross(w, bn[j]) >= 0
             )
-            got = self._tangents = (b, i[ok], j[ok])
+            # coincident corners (a pinch) span no line: their crossings are NaN anyway
+            ok &= np.hypot(w[:, 0], w[:, 1]) > 0
+            i, j = i[ok], j[ok]
+            if len(i):  # the line through the two corners meets K
+                u = w[ok] / np.hypot(w[ok, 0], w[ok, 1])[:, None]
+                r = 4.0 * env.scale  # both corners and K lie within the scene's size
+                lines = shapely.linestrings(np.stack([b[i] - r * u, b[i] + r * u], axis=1))
+                near = shapely.dwithin(lines, self._hull_poly, 1e-6 * env.scale)
+                i, j = i[near], j[near]
+            got = self._tangents = (b, bp, bn, i, j)
+        return got
+
+    def _anchors(self) -> np.ndarray:
+        """(len(env.vert),) bool: the convex obstacle corners (reflex vertices of the free
+        space) that see some point of K: within 1e-6 of the scene's size of K or of the
+        weak visibility region of K's outline (cached).  K holds every A_q, so the other
+        corners see no target: they are no grazing anchors of any stationary shadow
+        (:func:`~geometry.weak.weak_visibility`'s ``grazing``) and bound no beam into it."""
+        got = getattr(self, "_anchor_mask", None)
+        if got is None:
+            env = self.env
+            got = np.zeros(len(env.vert), dtype=bool)
+            idx = np.flatnonzero(env.reflex)
+            if len(idx):
+                ring = self.hull[::-1]  # clockwise: a hole of the domain
+                seen = weak_visibility(env, ring, np.ones(len(ring), dtype=bool))
+                seen = shapely.union(seen, self._hull_poly)
+                pts = shapely.points(env.vert[idx])
+                got[idx] = shapely.dwithin(seen, pts, 1e-6 * env.scale)
+            self._anchor_mask = got
         return got
 
     def _valid_many(self, vs: np.ndarray, ve: np.ndarray, ts: np.ndarray, q0, dq) -> np.ndarray:
@@ -1035,8 +1169,12 @@ def _drop_short(v: np.ndarray, length: float) -> np.ndarray:
         keep = list(range(len(v)))
     else:
         keep = [0]
+        long_step = step.tolist()  # right after a kept vertex the test is the step's
         for i in range(1, len(v)):
-            if np.abs(v[i] - v[keep[-1]]).max() >= length:
+            if keep[-1] == i - 1:
+                if long_step[i - 1]:
+                    keep.append(i)
+            elif np.abs(v[i] - v[keep[-1]]).max() >= length:
                 keep.append(i)
     while len(keep) > 1 and np.abs(v[keep[-1]] - v[0]).max() < length:
         keep.pop()

@@ -27,7 +27,11 @@ CONTACT_REL = 1e-9
 
 
 def weak_visibility(
-    env: Domain, ring: np.ndarray, wanted: np.ndarray, eps_aim: float = 0.0
+    env: Domain,
+    ring: np.ndarray,
+    wanted: np.ndarray,
+    eps_aim: float = 0.0,
+    grazing: np.ndarray | None = None,
 ) -> shapely.Geometry:
     """Placements that see some wanted piece of a target boundary.
 
@@ -39,6 +43,10 @@ def weak_visibility(
         (insert the cut points first).
     wanted : (m,) bool, True where segment ``ring[i] -> ring[i+1]`` is wanted.
     eps_aim : drop anchor fans narrower than this (radians).
+    grazing : optional (len(env.vert),) bool: the reflex vertices of ``env`` that may be
+        grazing anchors (the target's own vertices always may).  A caller that knows
+        that the other vertices see no point of the target (e.g. none of a region that
+        holds it) skips their ray casts; the answer is the same.
 
     Returns
     -------
@@ -84,6 +92,8 @@ def weak_visibility(
     # 2. grazing anchors: reflex vertices v of the free space around the target;
     #    first the directions in which v sees a wanted piece ...
     v_idx = np.flatnonzero(dom.reflex)
+    if grazing is not None:
+        v_idx = v_idx[(v_idx >= len(env.vert)) | grazing[np.minimum(v_idx, len(env.vert) - 1)]]
     v = dom.vert[v_idx]
     if len(v):
         rel = np.arctan2(ring[None, :, 1] - v[:, None, 1], ring[None, :, 0] - v[:, None, 0])
@@ -136,8 +146,14 @@ def _pinch_arcs(dom: Domain, idx: np.ndarray) -> np.ndarray | None:
     and padding elsewhere); ``None`` when none of them is a pinch."""
     if len(idx) == 0:
         return None
-    _, inv, cnt = np.unique(dom.vert, axis=0, return_inverse=True, return_counts=True)
-    inv = inv.reshape(-1)
+    # groups of equal vertices (as np.unique(axis=0) numbers them, by a lexicographic
+    # sort: only equality and the counts matter here)
+    order = np.lexsort((dom.vert[:, 1], dom.vert[:, 0]))
+    sv = dom.vert[order]
+    new = np.concatenate([[True], (sv[1:] != sv[:-1]).any(axis=1)])
+    inv = np.empty(len(order), dtype=np.int64)
+    inv[order] = np.cumsum(new) - 1
+    cnt = np.bincount(inv)
     group = inv[idx]
     hit = np.flatnonzero(cnt[group] >= 2)
     if len(hit) == 0:

@@ -95,3 +95,104 @@ def test_two_round_probing_equals_testing_every_probe(monkeypatch) -> None:
         assert np.array_equal(got, every)
         by_second += int((first & ~every).sum())
     assert by_second > 0  # not vacuous: the second round decides some of them
+
+
+def _unfiltered(sw: S.Sweeper) -> tuple[np.ndarray, ...]:
+    """Every convex corner, and every pair tangent at both (no "sees K" filter)."""
+    env = sw.env
+    b = env.vert[env.reflex]
+    bp = env.vert_prev[env.reflex] - b
+    bn = env.vert_next[env.reflex] - b
+    i, j = np.triu_indices(len(b), 1)
+    w = b[j] - b[i]
+    ok = (S._cross(w, bp[i]) * S._cross(w, bn[i]) >= 0) & (
+        S._cross(w, bp[j]) * S._cross(w, bn[j]) >= 0
+    )
+    return b, bp, bn, i[ok], j[ok]
+
+
+def test_probing_only_lines_into_k_equals_probing_all(monkeypatch) -> None:
+    """The corners that do not see K and the corner pairs whose line misses K are not
+    probed between: the traced edges' validity is the same as with all of them."""
+    sw = _sweeper(monkeypatch)
+    full = _unfiltered(sw)
+    got = sw._corners_and_tangents()
+    assert len(got[0]) < len(full[0]) and len(got[3]) < len(full[3])  # not vacuous
+    keys = [np.asarray(k) for k in sw._frames]
+    checked = 0
+    for q0, q1 in zip(keys[:-1], keys[1:], strict=True):
+        dq = q1 - q0
+        edges = sw._edges(*sw.shadow(q0))
+        if not edges or not np.hypot(*dq) > 0:
+            continue
+        ts = np.broadcast_to(np.linspace(0.0, 1.0, 9), (len(edges), 9))
+        vs, ve = sw._ends_many(edges, ts, q0, dq)
+        filtered = sw._valid_many(vs, ve, ts, q0, dq)
+        monkeypatch.setattr(sw, "_tangents", full)
+        every = sw._valid_many(vs, ve, ts, q0, dq)
+        monkeypatch.setattr(sw, "_tangents", got)
+        assert np.array_equal(filtered, every)
+        checked += filtered.size
+    assert checked > 0
+
+
+def test_skipping_fixed_edges_keeps_the_labels(monkeypatch) -> None:
+    """Edges between two environment vertices are not labelled: the moving edges and
+    their neighbours' keys are those of labelling every edge."""
+    sw = _sweeper(monkeypatch)
+    skipped = 0
+    for key in list(sw._frames)[:8]:
+        shadow, table, tid = sw.shadow(np.asarray(key))
+        fast = sw._edges(shadow, table, tid)
+        rings = S._rings(shapely.orient_polygons(shadow, exterior_cw=False))
+        vs = [
+            v
+            for r in rings
+            if len(v := S._drop_short(np.asarray(r.coords)[:-1, :2], sw.tol_lab)) >= 3
+        ]
+        off = np.cumsum([0] + [len(v) for v in vs])
+        skipped += int(sw._fixed_edges(np.concatenate(vs), off).sum())
+        monkeypatch.setattr(sw, "_fixed_edges", lambda v, off: np.zeros(len(v), dtype=bool))
+        slow = sw._edges(shadow, table, tid)
+        monkeypatch.delattr(sw, "_fixed_edges")
+        assert fast == slow
+    assert skipped > 0
+
+
+def test_batched_bisection_equals_step_by_step(monkeypatch) -> None:
+    """The death-time bisection in rounds of several levels returns the times of the
+    bisection one step at a time (bit for bit), whatever the validity along the way."""
+    sw = _sweeper(monkeypatch)
+    keys = [np.asarray(k) for k in sw._frames]
+    moved = 0
+    for q0, q1 in zip(keys[:-1], keys[1:], strict=True):
+        dq = q1 - q0
+        edges = sw._edges(*sw.shadow(q0))
+        if not edges or not np.hypot(*dq) > 0:
+            continue
+        t_ok, t_bad = np.zeros(len(edges)), np.ones(len(edges))
+        for _ in range(sw.bisect_steps):  # the definition
+            tm = 0.5 * (t_ok + t_bad)
+            a, b = sw._ends_many(edges, tm[:, None], q0, dq)
+            good = sw._valid_many(a, b, tm[:, None], q0, dq)[:, 0]
+            t_ok = np.where(good, tm, t_ok)
+            t_bad = np.where(good, t_bad, tm)
+        got = sw._bisect(edges, np.zeros(len(edges)), np.ones(len(edges)), q0, dq)
+        assert np.array_equal(got, t_ok)
+        moved += int(((got > 0) & (got < 0.99)).sum())
+    assert moved > 0  # not vacuous: some edges die inside the interval
+
+
+def test_skipping_corners_blind_to_k_keeps_the_shadows(monkeypatch) -> None:
+    """The stationary shadows of a sweep skip the grazing anchors that see no point of K:
+    the shadows are those with every anchor (bit for bit)."""
+    sw = _sweeper(monkeypatch)
+    mask = sw._anchors()
+    assert 0 < mask.sum() < sw.env.reflex.sum()  # not vacuous: some corners are skipped
+    for key in list(sw._frames)[:8]:
+        q = np.asarray(key)
+        sw._grazing = mask
+        fast = sw.shadow(q)[0]
+        sw._grazing = None
+        slow = sw.shadow(q)[0]
+        assert shapely.equals_exact(fast, slow, 0.0)
