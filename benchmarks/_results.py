@@ -36,6 +36,7 @@ DEFAULT_OUT = Path("runs") / "benchmarks"
 NAMES = (
     "envs",
     "family_breakdown",
+    "fuzz_contacts",
     "oracle",
     "policies",
     "pool_build",
