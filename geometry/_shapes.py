@@ -48,7 +48,8 @@ def snap_grid(pts: np.ndarray) -> float:
 
 
 def snapped(op: object, a: shapely.Geometry, b: shapely.Geometry, grid: float) -> shapely.Geometry:
-    """``op(a, b)`` (``shapely.intersection`` or ``shapely.difference``) of the areal parts,
+    """``op(a, b)`` (``shapely.intersection``, ``shapely.difference`` or ``shapely.union``) of
+    the areal parts,
     snap-rounded on ``grid`` (docs/DESIGN.md, "Contacts").  Snap-rounding can still raise on
     an input GEOS finds invalid ("Ring edge missing", contact fuzz seed 1672): then the
     floating overlay, then the floating overlay of the repaired inputs."""
@@ -77,7 +78,13 @@ def union_all(
     frame's scenes have scale about 1).  With ``grid_size`` the snap-rounding overlay is
     used directly."""
     if grid_size is not None:
-        return shapely.union_all(geoms, grid_size=grid_size)
+        try:
+            return shapely.union_all(geoms, grid_size=grid_size)
+        except shapely.errors.GEOSException:  # "Ring edge missing" (as in :func:`snapped`)
+            try:
+                return shapely.union_all(geoms)
+            except shapely.errors.GEOSException:
+                return shapely.union_all(shapely.make_valid(np.asarray(geoms, dtype=object)))
     try:
         return shapely.union_all(geoms)
     except shapely.errors.GEOSException:

@@ -224,3 +224,12 @@ def test_run_many_in_processes_matches_one_process():
     assert (two["valid"], two["violations"]) == (one["valid"], one["violations"])
     with pytest.raises(ValueError, match="jobs must be a positive integer"):
         run_many(4, jobs=0)
+
+
+def test_swept_scaled_snap_rounding_crash():
+    """Fuzz seed 201039 (``--swept --frames``): at scale 1e-3 the sweep's snap-rounded
+    union of an eroded shadow raised GEOS "Ring edge missing"; the overlays fall back to
+    the floating ones as the stationary clip does (``_shapes.snapped``)."""
+    d = fuzz_scene(201039, contacts=True)
+    findings, _ = check_scene(d, seed=201039, hang_s=120.0, frames=True, swept=True)
+    assert not [vars(f) for f in findings if f.kind == "crash"]
