@@ -236,11 +236,15 @@ def _rasters(sim: BatchSim, idx: np.ndarray, size: int) -> np.ndarray:
 
 
 class PlacementVectorObs:
-    def __init__(self, n_beams: int, grid_size: int = 64) -> None:
+    def __init__(self, n_beams: int, grid_size: int = 64, self_features: bool = False) -> None:
         self.n = n_beams
-        self._key = f"placement_vec{n_beams}"
-        low = np.concatenate([-np.ones(4), np.zeros(4 + 2 * n_beams)]).astype(np.float32)
-        self.space = spaces.Box(low, np.ones(8 + 2 * n_beams, dtype=np.float32), dtype=np.float32)
+        self.self_features = self_features
+        self._key = f"placement_vec{n_beams}" + ("_self" if self_features else "")
+        m = 2 if self_features else 0
+        low = np.concatenate([-np.ones(4), np.zeros(4 + 2 * n_beams + m)]).astype(np.float32)
+        self.space = spaces.Box(
+            low, np.ones(8 + 2 * n_beams + m, dtype=np.float32), dtype=np.float32
+        )
 
     def __call__(self, sim: BatchSim, idx: np.ndarray) -> np.ndarray:
         if sim._one_world:
@@ -266,6 +270,8 @@ class PlacementVectorObs:
         for g in (world.goal_center, world.failure_center):
             d = sensor.read((g[0], g[1], 0.0), world.seg_set)[0]
             out.extend(d / world.diameter)
+        if self.self_features:  # as the robot observations': fov / 360 degrees, reach / diameter
+            out.extend([world.fov / (2.0 * math.pi), min(world.max_range / world.diameter, 1.0)])
         arr = np.clip(np.asarray(out), self.space.low, self.space.high).astype(np.float32)
         world._cache[key] = arr
         return arr
@@ -307,6 +313,8 @@ def make_observation(
         ("placement", "vector"): PlacementVectorObs,
         ("placement", "grid"): PlacementGridObs,
     }
+    if kind == "placement" and self_features:
+        return PlacementVectorObs(n_beams, grid_size, self_features=True)
     if map_ranges or map_evidence or sensor_fov or self_features:
         return RobotVectorObs(
             n_beams,

@@ -64,8 +64,8 @@ map_evidence : bool, default False -- per beam, whether it read shorter than the
     the map; vector observations of Navigate/Recognize).
 sensor_fov : bool, default False -- Navigate/Recognize vector observations end with the
     sensor's field of view / 360 degrees (for scenes whose field of view varies).
-self_features : bool, default False -- Navigate/Recognize vector observations end with what
-    the robot knows of its own sensor: field of view / 360 degrees and reach (maximum range,
+self_features : bool, default False -- vector observations (Navigate, Recognize, Placement)
+    end with what the robot knows of its own sensor: field of view / 360 degrees and reach (maximum range,
     at most the diameter) / scene diameter (for scene families whose sensors differ).
 max_steps : int | None -- the time limit (default 200; Placement: 1).
 random_scene_kwargs : dict | None -- passed to ``random_scene`` when ``scene="random"``.
@@ -365,8 +365,14 @@ class SensorPlanBatch(BatchSim):
         ):
             if not isinstance(v, bool):
                 raise ValueError(f"{name} must be True or False, got {v!r}")
-            if v and (obs_type != "vector" or self.obs_kind != "robot"):
-                raise ValueError(f"{name}=True needs obs_type='vector' in Navigate or Recognize")
+            if not v or obs_type == "vector" and (
+                self.obs_kind == "robot" or name == "self_features"
+            ):
+                continue
+            raise ValueError(
+                f"{name}=True needs obs_type='vector' in Navigate or Recognize"
+                + (" (or Placement)" if name == "self_features" else "")
+            )
         self.map_ranges = map_ranges or map_evidence  # the sim computes the map's ranges
         self.params[fused.P_MAP] = self.map_ranges
         self.params[fused.P_OBS_MAP] = map_ranges

@@ -144,6 +144,27 @@ def test_self_features_are_the_sensors_fov_and_reach(env_id):
         gym.make(env_id, self_features=True, obs_type="grid")
 
 
+def test_placement_self_features():
+    """Placement-v0's vector observation ends with the same two values (issue 22 item 1)."""
+    env_id = "sensorplan/Placement-v0"
+    kw = dict(scene="random", family=RANGED, scene_pool_size=8)
+    env = gym.make(env_id, self_features=True, **kw)
+    plain = gym.make(env_id, **kw)
+    assert env.observation_space.shape[0] == plain.observation_space.shape[0] + 2
+    for seed in range(8):
+        obs, _ = env.reset(seed=seed)
+        ref, _ = plain.reset(seed=seed)
+        np.testing.assert_array_equal(obs[:-2], ref)
+        scene = env.unwrapped.world.scene
+        mr = scene.sensor.max_range
+        assert obs[-2] == pytest.approx(scene.sensor.fov_deg / 360.0, rel=1e-6)
+        assert obs[-1] == pytest.approx(1.0 if mr is None else min(mr / scene.diameter, 1.0))
+    with pytest.raises(ValueError, match="sensor_fov=True needs obs_type='vector' in Navigate"):
+        gym.make(env_id, sensor_fov=True)
+    with pytest.raises(ValueError, match=r"self_features=True needs .* \(or Placement\)"):
+        gym.make(env_id, self_features=True, obs_type="grid")
+
+
 def test_default_observation_shapes_are_unchanged():
     for env_id, n in ((NAV, 8 + 3 * 16), ("sensorplan/Recognize-v0", 8 + 3 * 16)):
         assert gym.make(env_id).observation_space.shape == (n,)
