@@ -65,8 +65,9 @@ map_evidence : bool, default False -- per beam, whether it read shorter than the
 sensor_fov : bool, default False -- Navigate/Recognize vector observations end with the
     sensor's field of view / 360 degrees (for scenes whose field of view varies).
 self_features : bool, default False -- vector observations (Navigate, Recognize, Placement)
-    end with what the robot knows of its own sensor: field of view / 360 degrees and reach (maximum range,
-    at most the diameter) / scene diameter (for scene families whose sensors differ).
+    end with what the robot knows of its own sensor: field of view / 360 degrees and reach
+    (maximum range, at most the diameter) / scene diameter (for scene families whose sensors
+    differ).
 max_steps : int | None -- the time limit (default 200; Placement: 1).
 random_scene_kwargs : dict | None -- passed to ``random_scene`` when ``scene="random"``.
 render_mode : ``None`` | ``"rgb_array"`` | ``"human"``.
@@ -365,8 +366,10 @@ class SensorPlanBatch(BatchSim):
         ):
             if not isinstance(v, bool):
                 raise ValueError(f"{name} must be True or False, got {v!r}")
-            if not v or obs_type == "vector" and (
-                self.obs_kind == "robot" or name == "self_features"
+            if (
+                not v
+                or obs_type == "vector"
+                and (self.obs_kind == "robot" or name == "self_features")
             ):
                 continue
             raise ValueError(
