@@ -79,10 +79,10 @@ def _all_at_once(sw: S.Sweeper, vs, ve, ts, q0, dq) -> tuple[np.ndarray, np.ndar
     return every, first & (ln > 0)
 
 
-def test_two_round_probing_equals_testing_every_probe(monkeypatch) -> None:
-    sw = _sweeper(monkeypatch)
+def _traced_steps(sw: S.Sweeper):
+    """Per pair of consecutive sampled configurations with shadow edges: ``(q0, dq, ts, vs,
+    ve)``, the edges' ends at 9 times between them (what ``_valid_many`` checks)."""
     keys = [np.asarray(k) for k in sw._frames]
-    by_second = 0
     for q0, q1 in zip(keys[:-1], keys[1:], strict=True):
         dq = q1 - q0
         edges = sw._edges(*sw.shadow(q0))
@@ -90,6 +90,13 @@ def test_two_round_probing_equals_testing_every_probe(monkeypatch) -> None:
             continue
         ts = np.broadcast_to(np.linspace(0.0, 1.0, 9), (len(edges), 9))
         vs, ve = sw._ends_many(edges, ts, q0, dq)
+        yield q0, dq, ts, vs, ve
+
+
+def test_two_round_probing_equals_testing_every_probe(monkeypatch) -> None:
+    sw = _sweeper(monkeypatch)
+    by_second = 0
+    for q0, dq, ts, vs, ve in _traced_steps(sw):
         got = sw._valid_many(vs, ve, ts, q0, dq)
         every, first = _all_at_once(sw, vs, ve, ts, q0, dq)
         assert np.array_equal(got, every)
@@ -118,15 +125,8 @@ def test_probing_only_lines_into_k_equals_probing_all(monkeypatch) -> None:
     full = _unfiltered(sw)
     got = sw._corners_and_tangents()
     assert len(got[0]) < len(full[0]) and len(got[3]) < len(full[3])  # not vacuous
-    keys = [np.asarray(k) for k in sw._frames]
     checked = 0
-    for q0, q1 in zip(keys[:-1], keys[1:], strict=True):
-        dq = q1 - q0
-        edges = sw._edges(*sw.shadow(q0))
-        if not edges or not np.hypot(*dq) > 0:
-            continue
-        ts = np.broadcast_to(np.linspace(0.0, 1.0, 9), (len(edges), 9))
-        vs, ve = sw._ends_many(edges, ts, q0, dq)
+    for q0, dq, ts, vs, ve in _traced_steps(sw):
         filtered = sw._valid_many(vs, ve, ts, q0, dq)
         monkeypatch.setattr(sw, "_tangents", full)
         every = sw._valid_many(vs, ve, ts, q0, dq)
