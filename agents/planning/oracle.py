@@ -415,7 +415,7 @@ class _SubEnv:
         self.batch = batch
         self.i = int(i)
         self.spec = None
-        self.max_turn = batch.max_turn
+        self.max_turn = getattr(batch, "max_turn", None)  # Placement has no robot
         self.speed_limit = getattr(batch, "speed_limit", "box")
         self.max_steps = batch.max_steps
 

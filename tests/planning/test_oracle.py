@@ -64,6 +64,20 @@ def test_oracle_works_with_sb3_evaluate_policy():
     assert mean > 0.8  # +1 success bonus minus a few step costs
 
 
+def test_oracle_drives_a_native_placement_vector_env():
+    """The per-sub-environment views of a batched env serve Placement too (no robot, no
+    ``max_turn``): what ``sensorplan imitate`` labels with."""
+    venv = gym.make_vec(
+        "sensorplan/Placement-v0", num_envs=3, vectorization_mode="vector_entry_point",
+        scene="random", scene_pool_size=6,
+    )  # fmt: skip
+    pol = OraclePolicy(venv)
+    venv.reset(seed=3)
+    actions, _ = pol.predict(None)
+    _, reward, term, _, info = venv.step(actions)
+    assert term.all() and info["is_success"].all() and (reward == 1.0).all()
+
+
 def world(d: dict, **cfg) -> World:
     return World(Scene.from_dict(d), WorldConfig(**cfg))
 
