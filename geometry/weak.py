@@ -81,7 +81,7 @@ def weak_visibility(
             for e, along, use in (
                 (edge[i], edge[i], wanted[i]),
                 (edge[i - 1], -edge[i - 1], wanted[i - 1]),
-            ):  # noqa: E501
+            ):
                 if use:
                     f = e[0] * d[:, 1] - e[1] * d[:, 0] > 0
                     if arcs is not None:
