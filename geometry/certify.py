@@ -53,9 +53,10 @@ from ._common import (
 from ._frame import world_messages
 from ._shapes import ccw_ring, union_all
 from .mixed import _point_side, point_strips
-from .partial import _partial_region, _swept_region, swept_tol
+from .partial import _hole_ring, _partial_region, _swept_region, swept_tol
 from .recognize import _accuracy, overlap_strips
 from .sweep import QueryTimeout
+from .weak import weak_visibility
 
 if TYPE_CHECKING:  # pragma: no cover
     from .scene import Scene
@@ -242,9 +243,6 @@ def proven_inner(
     B_sigma is empty (longer than the target is wide) is halved, up to ``max_split``
     times; ``None`` if one stays empty.  Snap-rounded on ``grid`` like the outer bound.
     """
-    from .partial import _hole_ring
-    from .weak import weak_visibility
-
     if region.geom_type != "Polygon":
         return None
     ring = region.exterior
