@@ -228,6 +228,7 @@ OBSERVATION_KWARGS = (
     "placement_grid",
     "placement_aims",
     "self_features",
+    "aim_features",
 )
 
 

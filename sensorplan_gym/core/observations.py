@@ -25,6 +25,14 @@ obstacles, G, H), its own pose, and its sensor readings.  The hidden target of
     degrees and the sensor's reach (its maximum range, at most the scene's diameter) divided
     by the scene's diameter (1: unlimited), both in (0, 1] -- what the robot knows about its
     own sensor, so one policy can serve scene families whose sensors differ.
+    With ``aim_features=True``, ten more values last (:func:`aim_features`): for the shortest
+    arc of directions covering both K_G and K_H (the hulls of the target swept over G and
+    over H), then for K_G's and K_H's own arcs, the cosine and sine of the arc's centre
+    relative to the heading and its width divided by 360 degrees (1 where the robot stands
+    in a hull); then the distance to the farthest vertex of K_G and K_H divided by the
+    sensor's reach, clipped to 1 -- geometry of the map relative to the robot's pose, the
+    quantities an aim must satisfy (a narrow field of view needs the joint width below it),
+    not the recognizable region.
 
     Placement, length ``8 + 2 * n_beams``: centres of G and H scaled to [-1, 1],
     the width and height of G and H's bounding boxes divided by the scene's span,
@@ -50,6 +58,7 @@ from gymnasium import spaces
 
 from . import fused
 from .kernels import libm
+from .queries import hull_arcs, joint_arc
 from .sensor import RangeSensor
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -98,9 +107,11 @@ class RobotVectorObs:
         map_evidence: bool = False,
         sensor_fov: bool = False,
         self_features: bool = False,
+        aim_features: bool = False,
     ) -> None:
         self.n = n_beams
         n = n_beams
+        self.aim_features = aim_features
         self.map_ranges = map_ranges
         self.map_evidence = map_evidence
         self.sensor_fov = sensor_fov
@@ -108,8 +119,10 @@ class RobotVectorObs:
         m = (n if map_ranges else 0) + (2 * n if map_evidence else 0) + (1 if sensor_fov else 0)
         m += 2 if self_features else 0
         low = np.concatenate([-np.ones(8), np.zeros(n), -np.ones(2 * n), np.zeros(m)])
+        if aim_features:
+            low = np.concatenate([low, np.tile([-1.0, -1.0, 0.0], 3), [0.0]])
         self.space = spaces.Box(
-            low.astype(np.float32), np.ones(8 + 3 * n + m, dtype=np.float32), dtype=np.float32
+            low.astype(np.float32), np.ones(len(low), dtype=np.float32), dtype=np.float32
         )
 
     @property
@@ -133,8 +146,8 @@ class RobotVectorObs:
 
     def tail(self, sim: BatchSim, sel, x, y, psi) -> np.ndarray:
         """The entries after :attr:`head` ``(k, D - head)`` float64: ``map_evidence``'s
-        flags, then ``sensor_fov``, then ``self_features``.  A new entry goes here (and in
-        the space's bounds)."""
+        flags, then ``sensor_fov``, then ``self_features``, then ``aim_features``.  A new
+        entry goes here (and in the space's bounds)."""
         parts = []
         if self.map_evidence:
             parts.append(map_evidence(sim, sel, x, y, psi).reshape(len(x), 2 * self.n))
@@ -144,6 +157,8 @@ class RobotVectorObs:
             fov = sim.fov[sel] / (2.0 * math.pi)
             reach = np.minimum(sim.reach[sel] * sim.obs_consts[sel, 4], 1.0)
             parts.append(np.column_stack([fov, reach]))
+        if self.aim_features:
+            parts.append(aim_features(sim.hulls[sel], sim.reach[sel], x, y, psi))
         return np.concatenate(parts, axis=1)
 
     def _numpy(self, sim: BatchSim, idx: np.ndarray) -> np.ndarray:
@@ -229,6 +244,27 @@ def map_evidence(sim: BatchSim, sel, x, y, psi) -> np.ndarray:
     return (inside & short[:, None, :]).astype(np.float64)
 
 
+def aim_features(hulls: np.ndarray, reach: np.ndarray, x, y, psi) -> np.ndarray:
+    """``(k, 10)`` float64: the ``aim_features`` of poses ``(x, y, psi)`` (world frame,
+    radians) with K_G and K_H ``hulls`` ``(k, 2, K, 2)`` and the sensor's ``reach``
+    ``(k,)``: ``cos, sin`` of the centre of the arc covering both hulls relative to the
+    heading, its width / 2 pi, the same for K_G's and for K_H's arc
+    (:func:`.queries.hull_arcs`, :func:`.queries.joint_arc`), then the farthest hull
+    vertex's distance / reach clipped to ``[0, 1]``."""
+    start, width = hull_arcs(hulls, x, y)
+    js, jw = joint_arc(start, width)
+    s = np.column_stack([js, start])  # (k, 3): joint, G, H
+    w = np.column_stack([jw, width])
+    rel = s + 0.5 * w - psi[:, None]
+    out = np.empty((len(x), 10))
+    out[:, 0:9:3] = np.cos(rel)
+    out[:, 1:9:3] = np.sin(rel)
+    out[:, 2:9:3] = w / (2.0 * math.pi)
+    far = np.hypot(hulls[..., 0] - x[:, None, None], hulls[..., 1] - y[:, None, None])
+    out[:, 9] = np.clip(far.max(axis=(1, 2)) / reach, 0.0, 1.0)
+    return out
+
+
 def _rasters(sim: BatchSim, idx: np.ndarray, size: int) -> np.ndarray:
     if sim._one_world:
         return sim.worlds[0].raster(size)[None]
@@ -300,11 +336,12 @@ def make_observation(
     map_evidence: bool = False,
     sensor_fov: bool = False,
     self_features: bool = False,
+    aim_features: bool = False,
 ):
     """The observation builder for env ``kind`` ("robot" or "placement") and ``obs_type``;
     ``map_ranges`` / ``map_evidence`` / ``sensor_fov`` / ``self_features``: robot vector
     observations carry the map-predicted ranges / the per-beam evidence flags / the field of
-    view / the field of view and the reach too."""
+    view / the field of view and the reach too / the arcs of K_G and K_H (:func:`aim_features`)."""
     if obs_type not in OBS_TYPES:
         raise ValueError(f"obs_type must be one of {OBS_TYPES}, got {obs_type!r}")
     table = {
@@ -315,7 +352,7 @@ def make_observation(
     }
     if kind == "placement" and self_features:
         return PlacementVectorObs(n_beams, grid_size, self_features=True)
-    if map_ranges or map_evidence or sensor_fov or self_features:
+    if map_ranges or map_evidence or sensor_fov or self_features or aim_features:
         return RobotVectorObs(
             n_beams,
             grid_size,
@@ -323,5 +360,6 @@ def make_observation(
             map_evidence=map_evidence,
             sensor_fov=sensor_fov,
             self_features=self_features,
+            aim_features=aim_features,
         )
     return table[(kind, obs_type)](n_beams, grid_size)

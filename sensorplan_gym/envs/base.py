@@ -68,6 +68,10 @@ self_features : bool, default False -- vector observations (Navigate, Recognize,
     end with what the robot knows of its own sensor: field of view / 360 degrees and reach
     (maximum range, at most the diameter) / scene diameter (for scene families whose sensors
     differ).
+aim_features : bool, default False -- Navigate/Recognize vector observations end with the
+    arcs of directions that K_G and K_H (the swept hulls) cover from the robot's pose, relative
+    to its heading, and their farthest vertex's distance over the reach (see
+    :mod:`sensorplan_gym.core.observations`): map geometry an aim must satisfy.
 max_steps : int | None -- the time limit (default 200; Placement: 1).
 random_scene_kwargs : dict | None -- passed to ``random_scene`` when ``scene="random"``.
 render_mode : ``None`` | ``"rgb_array"`` | ``"human"``.
@@ -326,6 +330,7 @@ class SensorPlanBatch(BatchSim):
         map_evidence: bool = False,
         sensor_fov: bool = False,
         self_features: bool = False,
+        aim_features: bool = False,
         **action_kw: Any,
     ) -> None:
         for name, v in (
@@ -363,6 +368,7 @@ class SensorPlanBatch(BatchSim):
             ("map_evidence", map_evidence),
             ("sensor_fov", sensor_fov),
             ("self_features", self_features),
+            ("aim_features", aim_features),
         ):
             if not isinstance(v, bool):
                 raise ValueError(f"{name} must be True or False, got {v!r}")
@@ -390,6 +396,7 @@ class SensorPlanBatch(BatchSim):
             map_evidence=map_evidence,
             sensor_fov=sensor_fov,
             self_features=self_features,
+            aim_features=aim_features,
         )
         self.single_observation_space = self.obs.space
         self.actions = make_actions(action_type, self.action_task, self.action_dim, **action_kw)
