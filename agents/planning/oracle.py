@@ -30,6 +30,7 @@ and the sensor readings the agent also gets.
 from __future__ import annotations
 
 import math
+import weakref
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -64,6 +65,10 @@ def _aim_for(world, p: np.ndarray) -> tuple[float, float]:
     return float(psi), float(margin)
 
 
+#: per world, the aim-feasible part of a region (:func:`_aim_feasible_region`), by region
+_FEASIBLE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
 def _aim_feasible_region(world, region: shapely.Geometry, n: int = 24) -> shapely.Geometry:
     """The part of ``region`` where one aim satisfies the field of view, approximated from
     inside by the cells of an ``n x n`` grid over its bounding box whose four corners all
@@ -71,10 +76,15 @@ def _aim_feasible_region(world, region: shapely.Geometry, n: int = 24) -> shapel
     thin region in a large box can fall between the corners of a coarse one."""
     if world.fov >= 2 * math.pi - 1e-12 and math.isinf(world.max_range):
         return region
+    kept = _FEASIBLE.setdefault(world, {})
+    hit = kept.get((id(region), n))
+    if hit is not None and hit[0] is region:  # the world's own region: computed once
+        return hit[1]
     for k in (n, 2 * n, 4 * n, 8 * n):
         cells = _aim_feasible_cells(world, region, k)
         if not cells.is_empty:
-            return cells
+            break
+    kept[(id(region), n)] = (region, cells)
     return cells
 
 
@@ -130,6 +140,9 @@ def plan_viewpoint(
         room = min(room, float(keep_out.distance(here)))
     rr = world.robot_radius
     clearance = max(rr, min(rr + 1e-4 * world.diameter, rr + 0.25 * (room - rr)))
+    if clearance > rr:  # rounded down to a power of two: few distinct spaces, so their path
+        # fields are reused (choose_placement keeps them); less clearance is still free
+        clearance = rr + 2.0 ** math.floor(math.log2(clearance - rr))
 
     def attempt(reg: shapely.Geometry) -> ViewpointPlan:
         # a region thinner than twice the margin vanishes when shrunk: then smaller margins

@@ -32,6 +32,7 @@ to move around corners").  Here:
 from __future__ import annotations
 
 import math
+from collections import OrderedDict
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
@@ -46,6 +47,7 @@ if TYPE_CHECKING:  # pragma: no cover
 __all__ = [
     "PLAN_QUAD_SEGS",
     "Path",
+    "PathField",
     "Placement",
     "best_aim",
     "best_joint_aim",
@@ -278,18 +280,6 @@ def _visible(cover: BaseGeometry, p: np.ndarray, q: np.ndarray) -> np.ndarray:
     return np.asarray(shapely.covers(cover, lines), dtype=bool)
 
 
-def _dijkstra(n: int, i: np.ndarray, j: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Single-source (node 0) shortest distances and predecessors on an undirected graph."""
-    from scipy.sparse import coo_matrix  # imported lazily: scipy loads in ~0.5 s
-    from scipy.sparse.csgraph import dijkstra
-
-    # zero-length edges would vanish from a sparse matrix: give them a tiny positive weight
-    w = np.maximum(w, 1e-300)
-    g = coo_matrix((w, (i, j)), shape=(n, n)).tocsr()
-    dist, pred = dijkstra(g, directed=False, indices=0, return_predecessors=True)
-    return dist, pred
-
-
 def _goal_candidates(target: BaseGeometry, nodes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """End-point candidates for each node: (node index, point) pairs.
 
@@ -376,78 +366,145 @@ def shortest_path(
 
     Method
     ------
-    Exact for polygonal domains: a shortest path bends only at reflex vertices of the domain, so
-    the visibility graph of {start} + reflex vertices (edges kept only when the line supports the
-    corners it touches, and the segment lies in the domain) is searched with Dijkstra; the last
-    leg from a graph node u ends at the point of the region nearest to u among those u sees,
-    which is u's nearest region point, a region vertex, or the foot of a perpendicular from u
-    onto a region edge facing u.  All (node, end point) candidates are sorted by total length and
-    checked for visibility lazily, in batches; the first visible one is optimal.  When the start
-    sees its nearest region point, the answer is that point reached in a straight line: the
-    paper's one-step motion.  Segments may touch the domain boundary (tolerance ``1e-9`` times
-    the domain size).
+    :class:`PathField` for this space and goal, asked once; a caller with many starts and one
+    goal (the oracle replanning every step) keeps the field instead.
     """
     if isinstance(space, BaseGeometry):
         cspace = _polygonal(space)
     else:
         cspace = grow_free_space(space, robot_radius)
-    s = np.asarray(start, dtype=float).reshape(-1)[:2]
-    if cspace.is_empty or not np.all(np.isfinite(s)):
-        return None
-    tol = _TOL_REL * max(_size(cspace), 1.0)
-    cover = shapely.buffer(cspace, tol, join_style="mitre")
-    shapely.prepare(cover)
-    sp = shapely.Point(s)
-    if not cover.covers(sp):
-        return None
-    target = shapely.intersection(goal_region, cover)
-    if target.is_empty:
-        return None
-    if shapely.distance(sp, target) <= tol:  # already there
-        return Path(np.array([s, s]), 0.0)
+    return PathField(cspace, goal_region).path(start)
 
-    # --- one-step motion (paper 6.2): the start sees its nearest region point
-    q0 = np.asarray(shapely.get_coordinates(shapely.shortest_line(sp, target))[1])
-    if _visible(cover, s[None], q0[None])[0]:
-        return Path(np.array([s, q0]), float(np.hypot(*(q0 - s))))
 
-    # --- visibility graph over {start} + reflex vertices
-    rv, ra, rb = _reflex_vertices(cspace)
-    nodes = np.vstack([s[None], rv])
-    nan = np.full((1, 2), np.nan)
-    na = np.vstack([nan, ra])
-    nb = np.vstack([nan, rb])
-    n = len(nodes)
-    iu, ju = np.triu_indices(n, k=1)
-    d = nodes[ju] - nodes[iu]
-    ok = _tangent(nodes[iu], na[iu], nb[iu], d) & _tangent(nodes[ju], na[ju], nb[ju], d)
-    iu, ju = iu[ok], ju[ok]
-    vis = _visible(cover, nodes[iu], nodes[ju])
-    iu, ju = iu[vis], ju[vis]
-    w = np.hypot(*(nodes[ju] - nodes[iu]).T)
-    dist, pred = _dijkstra(n, iu, ju, w)
+class PathField:
+    """Shortest collision-free paths from any start to one goal region in one configuration
+    space: the visibility graph of the space's reflex vertices and each vertex's distance to
+    the goal, built once (on the first start that needs them) and asked per start.
 
-    # --- end-point candidates, lazily checked in order of total length
-    reach = np.flatnonzero(np.isfinite(dist))
-    ci, cq = _goal_candidates(target, nodes[reach])
-    ci = reach[ci]
-    cd = cq - nodes[ci]
-    ok = _tangent(nodes[ci], na[ci], nb[ci], cd)
-    ci, cq, cd = ci[ok], cq[ok], cd[ok]
-    cost = dist[ci] + np.hypot(*cd.T)
-    order = np.argsort(cost, kind="stable")
-    for b0 in range(0, len(order), _BATCH):
-        sel = order[b0 : b0 + _BATCH]
-        vis = _visible(cover, nodes[ci[sel]], cq[sel])
-        if vis.any():
-            best = sel[int(np.argmax(vis))]
-            u = int(ci[best])
-            chain = [u]
-            while chain[-1] != 0:
-                chain.append(int(pred[chain[-1]]))
-            pts = np.vstack([nodes[chain[::-1]], cq[best][None]])
-            return Path(pts, float(np.hypot(*np.diff(pts, axis=0).T).sum()))
-    return None
+    Exact for polygonal domains: a shortest path bends only at reflex vertices of the domain,
+    so it runs start -> (visible reflex vertex -> ...) -> goal point.  The graph keeps an edge
+    between two reflex vertices when the line supports the corners it touches and the segment
+    lies in the domain.  The last leg from a vertex u ends at the point of the goal nearest to
+    u among those u sees: u's nearest goal point, a goal vertex, or the foot of a
+    perpendicular from u onto a goal edge facing u.  ``H(u)``, u's path length to the goal, is
+    one multi-source Dijkstra from those last legs.  A start's path is then the shortest of its
+    own last legs and ``|s - v| + H(v)`` over the vertices v it sees (candidates sorted by
+    length and checked for visibility lazily, in batches: the first visible one is optimal) --
+    the same optimum as a Dijkstra from the start over the graph with the start in it.  When
+    the start sees its nearest goal point, the answer is that point reached in a straight
+    line: the paper's one-step motion.  Segments may touch the domain boundary (tolerance
+    ``1e-9`` times the domain size).
+
+    ``cspace``: shapely Polygon/MultiPolygon of robot-centre positions (world frame);
+    ``goal_region``: shapely geometry (world frame) of acceptable end points.
+    """
+
+    def __init__(self, cspace: BaseGeometry, goal_region: BaseGeometry) -> None:
+        self.cspace = _polygonal(cspace)
+        self.tol = _TOL_REL * max(_size(self.cspace), 1.0)
+        self.cover = shapely.buffer(self.cspace, self.tol, join_style="mitre")
+        shapely.prepare(self.cover)
+        empty = self.cspace.is_empty
+        self.target = shapely.Polygon() if empty else shapely.intersection(goal_region, self.cover)
+        self._graph: tuple | None = None
+
+    def _build(self) -> tuple:
+        """``(nodes, prev, next, H, hop, end)``: reflex vertices with their ring neighbours,
+        each one's path length to the goal (``inf``: none), the next vertex on that path
+        (``-1``: straight to ``end``, its goal point)."""
+        if self._graph is not None:
+            return self._graph
+        from scipy.sparse import coo_matrix  # imported lazily: scipy loads in ~0.5 s
+        from scipy.sparse.csgraph import dijkstra
+
+        nodes, na, nb = _reflex_vertices(self.cspace)
+        n = len(nodes)
+        iu, ju = np.triu_indices(n, k=1)
+        d = nodes[ju] - nodes[iu]
+        ok = _tangent(nodes[iu], na[iu], nb[iu], d) & _tangent(nodes[ju], na[ju], nb[ju], d)
+        iu, ju = iu[ok], ju[ok]
+        vis = _visible(self.cover, nodes[iu], nodes[ju])
+        iu, ju = iu[vis], ju[vis]
+        w = np.hypot(*(nodes[ju] - nodes[iu]).T)
+        # each vertex's last leg: its shortest visible goal candidate
+        last = np.full(n, np.inf)
+        end = np.full((n, 2), np.nan)
+        if n:
+            ci, cq = _goal_candidates(self.target, nodes)
+            cd = cq - nodes[ci]
+            keep = _tangent(nodes[ci], na[ci], nb[ci], cd)
+            ci, cq, cd = ci[keep], cq[keep], cd[keep]
+            cost = np.hypot(*cd.T)
+            order = np.lexsort((cost, ci))  # by vertex, then length
+            ci, cq, cost = ci[order], cq[order], cost[order]
+            open_ = np.ones(len(ci), dtype=bool)  # candidates of unresolved vertices
+            # each candidate's position among its vertex's candidates
+            first = np.r_[0, np.flatnonzero(np.diff(ci)) + 1]
+            counts = np.diff(np.r_[first, len(ci)])
+            rank = np.arange(len(ci)) - np.repeat(first, counts)
+            depth = 0
+            while open_.any():
+                # each unresolved vertex's candidates of ranks depth .. depth + 7, at once
+                sel = np.flatnonzero(open_ & (rank >= depth) & (rank < depth + 8))
+                if not len(sel):
+                    break
+                hit = _visible(self.cover, nodes[ci[sel]], cq[sel])
+                for k in sel[hit]:  # in order: a vertex's first visible is its shortest
+                    u = ci[k]
+                    if not np.isfinite(last[u]):
+                        last[u], end[u] = cost[k], cq[k]
+                open_ &= ~np.isfinite(last[ci])
+                depth += 8
+        # multi-source Dijkstra: a virtual source n joined to each vertex by its last leg
+        src = np.flatnonzero(np.isfinite(last))
+        i = np.concatenate([iu, np.full(len(src), n)])
+        j = np.concatenate([ju, src])
+        ww = np.maximum(np.concatenate([w, last[src]]), 1e-300)  # zero weights would vanish
+        g = coo_matrix((ww, (i, j)), shape=(n + 1, n + 1)).tocsr()
+        h, pred = dijkstra(g, directed=False, indices=n, return_predecessors=True)
+        hop = np.where(pred[:n] == n, -1, pred[:n])
+        self._graph = (nodes, na, nb, h[:n], hop, end)
+        return self._graph
+
+    def path(self, start: Any) -> Path | None:
+        """The shortest path (:class:`Path`) from ``start`` (x, y; world frame) to the goal,
+        or ``None`` when the start is not in the space (within the tolerance), the goal does
+        not meet it, or no collision-free path connects them."""
+        s = np.asarray(start, dtype=float).reshape(-1)[:2]
+        if self.cspace.is_empty or not np.all(np.isfinite(s)):
+            return None
+        sp = shapely.Point(s)
+        if not self.cover.covers(sp) or self.target.is_empty:
+            return None
+        if shapely.distance(sp, self.target) <= self.tol:  # already there
+            return Path(np.array([s, s]), 0.0)
+        # --- one-step motion (paper 6.2): the start sees its nearest goal point
+        q0 = np.asarray(shapely.get_coordinates(shapely.shortest_line(sp, self.target))[1])
+        if _visible(self.cover, s[None], q0[None])[0]:
+            return Path(np.array([s, q0]), float(np.hypot(*(q0 - s))))
+        nodes, na, nb, h, hop, end = self._build()
+        # --- the start's own last legs, then its first hops to a vertex
+        _, gq = _goal_candidates(self.target, s[None])
+        ok = np.isfinite(h) & _tangent(nodes, na, nb, nodes - s)
+        vi = np.flatnonzero(ok)
+        pts = np.vstack([gq, nodes[vi]])
+        cost = np.concatenate([np.hypot(*(gq - s).T), np.hypot(*(nodes[vi] - s).T) + h[vi]])
+        order = np.argsort(cost, kind="stable")
+        for b0 in range(0, len(order), _BATCH):
+            sel = order[b0 : b0 + _BATCH]
+            vis = _visible(self.cover, np.broadcast_to(s, (len(sel), 2)), pts[sel])
+            if vis.any():
+                best = int(sel[int(np.argmax(vis))])
+                chain = [s, pts[best]]
+                if best >= len(gq):  # through vertex u, then its hops to the goal
+                    u = int(vi[best - len(gq)])
+                    while hop[u] >= 0:
+                        u = int(hop[u])
+                        chain.append(nodes[u])
+                    chain.append(end[u])
+                out = np.vstack(chain)
+                return Path(out, float(np.hypot(*np.diff(out, axis=0).T).sum()))
+        return None
 
 
 # ---------------------------------------------------------------------------------------------
@@ -601,6 +658,41 @@ class Placement:
         return self.status == "ok"
 
 
+#: Placement fields kept by :func:`_placement_field` (least recently used dropped first): an
+#: oracle replanning every step of 64 sub-environments asks the same few dozen again and again.
+_FIELDS_KEPT = 256
+_FIELDS: OrderedDict = OrderedDict()
+
+
+def _placement_field(
+    scene: Scene,
+    region: BaseGeometry,
+    robot_radius: float,
+    margin: float,
+    keep_out: BaseGeometry | None,
+) -> tuple[BaseGeometry, BaseGeometry, BaseGeometry, PathField]:
+    """``(cspace, shrunk region, target, PathField)`` of :func:`choose_placement`, kept for
+    the same scene and region objects and the same radius, margin and keep-out (compared by
+    value).  The entry holds the scene and the region, so their ids stay theirs while kept."""
+    key = (id(scene), id(region), float(robot_radius), float(margin), keep_out)
+    hit = _FIELDS.get(key)
+    if hit is not None and hit[0] is scene and hit[1] is region:
+        _FIELDS.move_to_end(key)
+        return hit[2]
+    cspace = grow_free_space(scene, robot_radius, keep_out=keep_out)
+    shrunk = shrink_region(region, margin)
+    target = shapely.Polygon()
+    if not shrunk.is_empty and not cspace.is_empty:
+        target = shapely.intersection(shrunk, cspace)
+        if shrunk.geom_type in ("Polygon", "MultiPolygon"):
+            target = _polygonal(target)
+    out = (cspace, shrunk, target, PathField(cspace, target))
+    _FIELDS[key] = (scene, region, out)
+    if len(_FIELDS) > _FIELDS_KEPT:
+        _FIELDS.popitem(last=False)
+    return out
+
+
 def choose_placement(
     scene: Scene,
     region: BaseGeometry,
@@ -638,14 +730,13 @@ def choose_placement(
     ``"no_placement"`` and ``"unreachable"`` answers, with a ``reason``.
     """
     s = np.asarray(start_xy, dtype=float).reshape(-1)[:2]
-    cspace = grow_free_space(scene, robot_radius, keep_out=keep_out)
 
     def fail(status: str, reason: str, reg: BaseGeometry) -> Placement:
         return Placement(status, None, None, math.inf, False, reason, reg)
 
     if region is None or region.is_empty:
         return fail("no_placement", "the region is empty: no placement exists", shapely.Polygon())
-    shrunk = shrink_region(region, margin)
+    cspace, shrunk, target, paths = _placement_field(scene, region, robot_radius, margin, keep_out)
     if shrunk.is_empty:
         return fail(
             "no_placement",
@@ -659,9 +750,6 @@ def choose_placement(
             f"a robot of radius {robot_radius:g} fits nowhere in the free space",
             shapely.Polygon(),
         )
-    target = shapely.intersection(shrunk, cspace)
-    if shrunk.geom_type in ("Polygon", "MultiPolygon"):
-        target = _polygonal(target)
     if target.is_empty:
         return fail(
             "no_placement",
@@ -669,15 +757,14 @@ def choose_placement(
             f"{robot_radius:g}: no placement exists",
             target,
         )
-    tol = _TOL_REL * max(_size(cspace), 1.0)
-    if shapely.distance(shapely.Point(s), cspace) > tol:
+    if shapely.distance(shapely.Point(s), cspace) > paths.tol:
         return fail(
             "unreachable",
             f"the start ({s[0]:g}, {s[1]:g}) is not collision-free for a robot of radius "
             f"{robot_radius:g}",
             target,
         )
-    path = shortest_path(cspace, s, target)
+    path = paths.path(s)
     if path is None:
         return fail(
             "unreachable",
