@@ -131,7 +131,6 @@ def plan_viewpoint(
     region = world.region
     if region.is_empty:
         return ViewpointPlan("no_placement", reason="the recognizable region is empty")
-    # keep path corners a hair off the obstacles, but never more than the start allows
     here = shapely.Point(start)
     if keep_out is not None and keep_out.intersects(here):
         keep_out = None  # already inside it: cannot keep out
@@ -139,10 +138,12 @@ def plan_viewpoint(
     if keep_out is not None:
         room = min(room, float(keep_out.distance(here)))
     rr = world.robot_radius
-    clearance = max(rr, min(rr + 1e-4 * world.diameter, rr + 0.25 * (room - rr)))
-    if clearance > rr:  # rounded down to a power of two: few distinct spaces, so their path
-        # fields are reused (choose_placement keeps them); less clearance is still free
-        clearance = rr + 2.0 ** math.floor(math.log2(clearance - rr))
+    # keep path corners a hair off the obstacles (1e-4 D), less where the start is closer to
+    # them than 4e-4 D: the largest of a few levels the start allows, so that few distinct
+    # configuration spaces arise and their path fields are reused (choose_placement keeps them)
+    levels = np.array([1e-4, 1e-6, 1e-8]) * world.diameter
+    extra = levels[levels <= 0.25 * (room - rr)]
+    clearance = rr + (float(extra[0]) if len(extra) else 0.0)
 
     def attempt(reg: shapely.Geometry) -> ViewpointPlan:
         # a region thinner than twice the margin vanishes when shrunk: then smaller margins

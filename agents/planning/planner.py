@@ -49,6 +49,7 @@ __all__ = [
     "Path",
     "PathField",
     "Placement",
+    "VisibilityGraph",
     "best_aim",
     "best_joint_aim",
     "choose_placement",
@@ -376,6 +377,35 @@ def shortest_path(
     return PathField(cspace, goal_region).path(start)
 
 
+class VisibilityGraph:
+    """The reflex vertices of a configuration space ``cspace`` (shapely Polygon/MultiPolygon
+    of robot-centre positions, world frame) and the visibility edges between them: an edge
+    where the line supports the corners it touches and the segment lies in the space (within
+    ``tol`` = 1e-9 times the space's size).  Built on the first :meth:`edges` call; the same
+    for every goal, so the :class:`PathField` of several goals in one space share it."""
+
+    def __init__(self, cspace: BaseGeometry) -> None:
+        self.cspace = _polygonal(cspace)
+        self.tol = _TOL_REL * max(_size(self.cspace), 1.0)
+        self.cover = shapely.buffer(self.cspace, self.tol, join_style="mitre")
+        shapely.prepare(self.cover)
+        self._edges: tuple | None = None
+
+    def edges(self) -> tuple:
+        """``(nodes, prev, next, i, j, length)``: reflex vertices ``(n, 2)`` with their ring
+        neighbours, and the edges ``i[k] -- j[k]`` of Euclidean ``length[k]``."""
+        if self._edges is None:
+            nodes, na, nb = _reflex_vertices(self.cspace)
+            iu, ju = np.triu_indices(len(nodes), k=1)
+            d = nodes[ju] - nodes[iu]
+            ok = _tangent(nodes[iu], na[iu], nb[iu], d) & _tangent(nodes[ju], na[ju], nb[ju], d)
+            iu, ju = iu[ok], ju[ok]
+            vis = _visible(self.cover, nodes[iu], nodes[ju])
+            iu, ju = iu[vis], ju[vis]
+            self._edges = (nodes, na, nb, iu, ju, np.hypot(*(nodes[ju] - nodes[iu]).T))
+        return self._edges
+
+
 class PathField:
     """Shortest collision-free paths from any start to one goal region in one configuration
     space: the visibility graph of the space's reflex vertices and each vertex's distance to
@@ -399,11 +429,14 @@ class PathField:
     ``goal_region``: shapely geometry (world frame) of acceptable end points.
     """
 
-    def __init__(self, cspace: BaseGeometry, goal_region: BaseGeometry) -> None:
-        self.cspace = _polygonal(cspace)
-        self.tol = _TOL_REL * max(_size(self.cspace), 1.0)
-        self.cover = shapely.buffer(self.cspace, self.tol, join_style="mitre")
-        shapely.prepare(self.cover)
+    def __init__(
+        self,
+        cspace: BaseGeometry | VisibilityGraph,
+        goal_region: BaseGeometry,
+    ) -> None:
+        #: the space's reflex-vertex visibility graph (shared by the fields of one space)
+        self.graph = cspace if isinstance(cspace, VisibilityGraph) else VisibilityGraph(cspace)
+        self.cspace, self.tol, self.cover = self.graph.cspace, self.graph.tol, self.graph.cover
         empty = self.cspace.is_empty
         self.target = shapely.Polygon() if empty else shapely.intersection(goal_region, self.cover)
         self._graph: tuple | None = None
@@ -417,15 +450,8 @@ class PathField:
         from scipy.sparse import coo_matrix  # imported lazily: scipy loads in ~0.5 s
         from scipy.sparse.csgraph import dijkstra
 
-        nodes, na, nb = _reflex_vertices(self.cspace)
+        nodes, na, nb, iu, ju, w = self.graph.edges()
         n = len(nodes)
-        iu, ju = np.triu_indices(n, k=1)
-        d = nodes[ju] - nodes[iu]
-        ok = _tangent(nodes[iu], na[iu], nb[iu], d) & _tangent(nodes[ju], na[ju], nb[ju], d)
-        iu, ju = iu[ok], ju[ok]
-        vis = _visible(self.cover, nodes[iu], nodes[ju])
-        iu, ju = iu[vis], ju[vis]
-        w = np.hypot(*(nodes[ju] - nodes[iu]).T)
         # each vertex's last leg: its shortest visible goal candidate
         last = np.full(n, np.inf)
         end = np.full((n, 2), np.nan)
@@ -658,9 +684,10 @@ class Placement:
         return self.status == "ok"
 
 
-#: Placement fields kept by :func:`_placement_field` (least recently used dropped first): an
-#: oracle replanning every step of 64 sub-environments asks the same few dozen again and again.
-_FIELDS_KEPT = 256
+#: Placement fields and visibility graphs kept by :func:`_placement_field` (least recently used
+#: dropped first): an oracle replanning every step of 64 sub-environments of a scene pool asks
+#: the same ones again and again.
+_FIELDS_KEPT = 2048
 _FIELDS: OrderedDict = OrderedDict()
 
 
@@ -679,14 +706,22 @@ def _placement_field(
     if hit is not None and hit[0] is scene and hit[1] is region:
         _FIELDS.move_to_end(key)
         return hit[2]
-    cspace = grow_free_space(scene, robot_radius, keep_out=keep_out)
+    gkey = (id(scene), None, float(robot_radius), None, keep_out)
+    ghit = _FIELDS.get(gkey)
+    if ghit is not None and ghit[0] is scene:
+        _FIELDS.move_to_end(gkey)
+        graph = ghit[2]
+    else:
+        graph = VisibilityGraph(grow_free_space(scene, robot_radius, keep_out=keep_out))
+        _FIELDS[gkey] = (scene, None, graph)
+    cspace = graph.cspace
     shrunk = shrink_region(region, margin)
     target = shapely.Polygon()
     if not shrunk.is_empty and not cspace.is_empty:
         target = shapely.intersection(shrunk, cspace)
         if shrunk.geom_type in ("Polygon", "MultiPolygon"):
             target = _polygonal(target)
-    out = (cspace, shrunk, target, PathField(cspace, target))
+    out = (cspace, shrunk, target, PathField(graph, target))
     _FIELDS[key] = (scene, region, out)
     if len(_FIELDS) > _FIELDS_KEPT:
         _FIELDS.popitem(last=False)

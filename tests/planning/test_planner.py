@@ -371,3 +371,39 @@ def test_best_joint_aim_sees_two_sets_from_between_them():
     assert math.cos(a1 - a2) == pytest.approx(1.0)
     # inside one of them: no aim keeps it in view
     assert best_joint_aim((5.0, 0.0), [g, h], fov)[1] < 0
+
+
+def test_path_field_paths_are_optimal_on_a_real_map():
+    """One :class:`PathField` asked from many starts: every path is collision-free, ends in the
+    goal, is no shorter than the straight line, and is optimal by its own sub-paths (the path
+    from its first bend is the field's path from there, and the rest of it) -- and a second
+    field of the same space answers identically, and a fresh ``shortest_path`` too."""
+    import gymnasium as gym
+
+    import sensorplan_gym  # noqa: F401
+    from agents.planning.planner import PathField, VisibilityGraph
+
+    w = gym.make("sensorplan/Navigate-v0", scene="real/willow_south").unwrapped.world
+    cs = grow_free_space(w.scene, 1e-4 * w.diameter)
+    graph = VisibilityGraph(cs)
+    field = PathField(graph, w.region)
+    other = PathField(graph, w.region)
+    rng = np.random.default_rng(0)
+    x0, y0, x1, y1 = cs.bounds
+    pts = np.column_stack([rng.uniform(x0, x1, 400), rng.uniform(y0, y1, 400)])
+    pts = pts[shapely.contains_xy(cs, pts[:, 0], pts[:, 1])][:25]
+    bends = 0
+    for p in pts:
+        path = field.path(p)
+        assert path is not None
+        assert shapely.covers(field.cover, shapely.LineString(path.points))
+        assert shapely.distance(shapely.Point(path.end), field.target) <= 1e-9 * w.diameter
+        assert path.length >= shapely.distance(shapely.Point(p), field.target) - 1e-9
+        assert other.path(p).length == path.length
+        assert shortest_path(cs, p, w.region).length == pytest.approx(path.length, rel=1e-12)
+        if len(path.points) > 2:  # sub-path optimality from the first bend
+            bends += 1
+            rest = field.path(path.points[1])
+            first = float(np.hypot(*(path.points[1] - path.points[0])))
+            assert rest.length == pytest.approx(path.length - first, rel=1e-9, abs=1e-9)
+    assert bends >= 5
