@@ -138,12 +138,12 @@ def plan_viewpoint(
     if keep_out is not None:
         room = min(room, float(keep_out.distance(here)))
     rr = world.robot_radius
-    # keep path corners a hair off the obstacles (1e-4 D), less where the start is closer to
-    # them than 4e-4 D: the largest of a few levels the start allows, so that few distinct
-    # configuration spaces arise and their path fields are reused (choose_placement keeps them)
-    levels = np.array([1e-4, 1e-6, 1e-8]) * world.diameter
-    extra = levels[levels <= 0.25 * (room - rr)]
-    clearance = rr + (float(extra[0]) if len(extra) else 0.0)
+    # keep path corners a hair off the obstacles (1e-4 D), but never more than a quarter of
+    # the start's room; rounded down to a power of two, so that few distinct configuration
+    # spaces arise and their path fields are reused (choose_placement keeps them)
+    clearance = max(rr, min(rr + 1e-4 * world.diameter, rr + 0.25 * (room - rr)))
+    if clearance > rr:
+        clearance = rr + 2.0 ** math.floor(math.log2(clearance - rr))
 
     def attempt(reg: shapely.Geometry) -> ViewpointPlan:
         # a region thinner than twice the margin vanishes when shrunk: then smaller margins
