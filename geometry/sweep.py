@@ -166,6 +166,9 @@ class Sweeper:
         self.shadow_grid = math.ldexp(self.grid, -SHADOW_BITS)
         #: the ``grazing`` anchors of the stationary shadows (None: all; same answer)
         self._grazing: np.ndarray | None = None
+        #: per configuration (x, y) of a stationary shadow: the placements it does not hold
+        #: (target and weak visibility region, snap-rounded): see :func:`_union_pieces`
+        self._seen: dict[tuple[float, float], shapely.Geometry] = {}
 
     # ------------------------------------------------------------------ anchors
     def pos(self, ids: np.ndarray, q: np.ndarray) -> np.ndarray:
@@ -243,6 +246,7 @@ class Sweeper:
         g = self.shadow_grid
         if not wanted.any():
             shadow = snapped(shapely.difference, self.free, area, g)
+            self._seen[(float(q[0]), float(q[1]))] = area
         else:
             reg = weak_visibility(
                 self.env, ring[::-1], np.roll(wanted[::-1], -1), self.eps_aim, self._grazing
@@ -251,6 +255,7 @@ class Sweeper:
             # into lines, and a snap-rounded overlay refuses mixed-dimension input
             seen = areal(snapped(shapely.union, reg, area, g))
             shadow = snapped(shapely.difference, self.free, seen, g)
+            self._seen[(float(q[0]), float(q[1]))] = seen
         table = np.vstack([self.env.vert, ring])
         tid = np.concatenate([np.arange(self.n_fixed), ids])
         return polygonal(shadow), table, tid
@@ -1305,7 +1310,39 @@ def swept_shadows(
                 for t in ts:
                     q = a + t * (b - a)
                     samples.append((q - c, sw.shadow(q)[0]))
-    return polygonal(union_all(pieces, grid_size=sw.grid)), stats
+    return _union_pieces(sw, pieces), stats
+
+
+def _union_pieces(sw: Sweeper, pieces: list[shapely.Geometry]) -> shapely.Geometry:
+    """The union of the pieces of a sweep (its sampled stationary shadows and traced
+    quads), snap-rounded on ``sw.grid``.
+
+    The sampled shadows are ``S_k = F - X_k`` (``F`` the free space, ``X_k`` the target
+    and its weak visibility region at sample k, kept by :meth:`Sweeper.shadow`), so their
+    union is ``F - (X_1 n ... n X_n)`` (De Morgan): the intersection of the small sets
+    ``X_k`` (near the region, balanced pairwise) and one difference with the free space
+    replace the union of n shadows that each span the whole map (nearly coincident
+    copies of the free space's boundary: GEOS's overlay spent most of its time there).
+    The traced quads are united with that.  Every overlay snap-rounds on ``sw.grid``, as
+    the one union it replaces did (:func:`swept_shadows`).  Parts of ``F - X_k`` that
+    :meth:`Sweeper.shadow` dropped as float slivers (area below
+    ``geometry._shapes.SLIVER`` times their squared perimeter) are part of this union.
+    Shadows without their ``X_k`` (none expected) fall back to the plain union."""
+    by_id = {id(v[0]): k for k, v in sw._frames.items()}
+    keys = list(dict.fromkeys(by_id[id(p)] for p in pieces if id(p) in by_id))
+    rest = [p for p in pieces if id(p) not in by_id]
+    if not keys or any(k not in sw._seen for k in keys):
+        return polygonal(union_all(pieces, grid_size=sw.grid))
+    g = sw.grid
+    xs = [sw._seen[k] for k in keys]
+    while len(xs) > 1:
+        pairs = zip(xs[0::2], xs[1::2], strict=False)  # an odd one out waits a round
+        nxt = [areal(snapped(shapely.intersection, a, b, g)) for a, b in pairs]
+        xs = nxt + xs[len(nxt) * 2 :]
+    shadows = areal(snapped(shapely.difference, sw.free, xs[0], g))
+    if not rest:
+        return polygonal(shadows)
+    return polygonal(union_all([shadows, *rest], grid_size=g))
 
 
 def snap_grid(scale: float) -> float:
