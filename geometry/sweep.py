@@ -579,9 +579,13 @@ class Sweeper:
             # the areal part: GEOS's union of two nearly coincident shadows can carry
             # collapsed edges (LineStrings), and an overlay with such a collection fails
             # ("Result area inconsistent with overlay operation", fuzz seed 501057)
-            known = areal(shapely.union(frame(a)[0], frame(b)[0]))
+            known = None  # the shadows' union, only if their X (see _uncovered_seen) is not kept
             for t, toward in ((a, b), (b, a)):
-                edges = self._uncovered(frame(t)[1], t, toward, known, q0, dq)
+                edges = self._uncovered_seen(frame(t)[1], t, toward, (a, b), q0, q1)
+                if edges is None:
+                    if known is None:
+                        known = areal(shapely.union(frame(a)[0], frame(b)[0]))
+                    edges = self._uncovered(frame(t)[1], t, toward, known, q0, dq)
                 for e in frame(t)[1]:
                     if e not in edges:  # swept inside the known shadows: nothing to trace
                         cover.setdefault(e[1], []).append((a, b))
@@ -761,6 +765,77 @@ class Sweeper:
         rest = shapely.area(shapely.difference(polys, known))
         need = ~ok | (rest > 1e-9 * self.env.scale**2)
         return [e for e, n_ in zip(edges, need, strict=True) if n_]
+
+    def _uncovered_seen(
+        self, edges: list, t: float, toward: float, ab: tuple[float, float], q0, q1
+    ) -> list | None:
+        """:meth:`_uncovered` for the shadows ``S_a``, ``S_b`` at the sample times ``ab``
+        from what they do not hold, ``X_a`` and ``X_b`` (:meth:`shadow`); None when one
+        of them was not kept (the caller then unites the shadows).
+
+        ``S_a u S_b = F - (X_a n X_b)`` (``F`` the free space), so the part of a quad
+        outside the known shadows is ``(quad - F) u (quad n X_a n X_b)``: one
+        intersection of the two small sets (near the region, kept for :func:`_union_pieces`)
+        instead of the union of two whole-map shadows, and the small quads cut by it.
+        ``quad - F`` is left out where the quad lies in ``F`` grown by ``1e-12`` of the
+        scene's size (a prepared test): its area there is below ``_free_band`` (that
+        width times ``F``'s perimeter), which the threshold is lowered by, so no sweep
+        that :meth:`_uncovered` would trace is dropped; ``quad n X_a n X_b`` is not cut by
+        ``F`` (that area is only larger)."""
+        if not edges:
+            return []
+        ka, kb = (self._frame_key(q0, q1, u) for u in ab)
+        inter = self._seen_pair(ka, kb)
+        if inter is None:
+            return None
+        dq = q1 - q0
+        vs, ve = self._ends_many(edges, np.array([[t, toward]]), q0, dq)  # (E, 2, 2) each
+        quads = np.stack([vs[:, 0], vs[:, 1], ve[:, 1], ve[:, 0]], axis=1)
+        ok = np.isfinite(quads).all(axis=(1, 2))
+        polys = shapely.make_valid(shapely.polygons(np.where(ok[:, None, None], quads, 0.0)))
+        grown, band = self._free_grown_eps()
+        rest = np.zeros(len(polys))
+        idx = np.flatnonzero(ok)
+        meets = shapely.intersects(inter, polys[idx])
+        rest[idx[meets]] = shapely.area(shapely.intersection(polys[idx[meets]], inter))
+        out = idx[~shapely.covers(grown, polys[idx])]
+        if len(out):
+            rest[out] += shapely.area(shapely.difference(polys[out], self.free))
+        need = ~ok | (rest > 1e-9 * self.env.scale**2 - band)
+        return [e for e, n_ in zip(edges, need, strict=True) if n_]
+
+    @staticmethod
+    def _frame_key(q0: np.ndarray, q1: np.ndarray, t: float) -> tuple[float, float]:
+        """The key of the sample at time ``t`` of the sweep ``q0 -> q1`` in ``_frames``
+        and ``_seen`` (as :meth:`along` computes it)."""
+        q = q1 if t == 1.0 else q0 + t * (q1 - q0)
+        return (float(q[0]), float(q[1]))
+
+    def _seen_pair(self, ka: tuple, kb: tuple) -> shapely.Geometry | None:
+        """``X_a n X_b`` for the samples at ``ka``, ``kb`` (snap-rounded on ``grid``,
+        prepared, cached: :func:`_union_pieces` starts from these); None when one of them
+        was not kept."""
+        pairs = self.__dict__.setdefault("_pairs", {})
+        got = pairs.get((ka, kb))
+        if got is None:
+            xa, xb = self._seen.get(ka), self._seen.get(kb)
+            if xa is None or xb is None:
+                return None
+            got = pairs[(ka, kb)] = areal(snapped(shapely.intersection, xa, xb, self.grid))
+            shapely.prepare(got)
+        return got
+
+    def _free_grown_eps(self) -> tuple[shapely.Geometry, float]:
+        """The free space grown by ``1e-12`` of the scene's size (prepared) and a bound on
+        the area of that band (the width times the free space's perimeter, doubled),
+        cached."""
+        got = getattr(self, "_free_eps", None)
+        if got is None:
+            eps = 1e-12 * self.env.scale
+            grown = shapely.buffer(self.free, eps)
+            shapely.prepare(grown)
+            got = self._free_eps = (grown, 2.0 * eps * float(shapely.length(self.free)))
+        return got
 
     def _coverage_gap(
         self, ea: list, eb: list, cover: dict, a: float, b: float, confirmed: set
@@ -1334,7 +1409,16 @@ def _union_pieces(sw: Sweeper, pieces: list[shapely.Geometry]) -> shapely.Geomet
     if not keys or any(k not in sw._seen for k in keys):
         return polygonal(union_all(pieces, grid_size=sw.grid))
     g = sw.grid
-    xs = [sw._seen[k] for k in keys]
+    pairs = sw.__dict__.get("_pairs", {})
+    xs = []
+    i = 0
+    while i < len(keys):  # consecutive samples: their intersection is often kept already
+        if i + 1 < len(keys) and (keys[i], keys[i + 1]) in pairs:
+            xs.append(pairs[(keys[i], keys[i + 1])])
+            i += 2
+        else:
+            xs.append(sw._seen[keys[i]])
+            i += 1
     while len(xs) > 1:
         pairs = zip(xs[0::2], xs[1::2], strict=False)  # an odd one out waits a round
         nxt = [areal(snapped(shapely.intersection, a, b, g)) for a, b in pairs]
