@@ -66,7 +66,7 @@ from ._shapes import cross as _cross
 from ._vis import TAU, Domain, RayEscapeError, gaps_many
 from .weak import ENV as _ENV
 from .weak import WANTED as _WANTED
-from .weak import weak_visibility
+from .weak import weak_visibility, weak_visibility_many
 
 #: The union of the pieces is snap-rounded onto a grid of ``2**-GRID_BITS`` of the scene's
 #: size (about 1e-12): see :func:`swept_shadows`.
@@ -169,6 +169,9 @@ class Sweeper:
         #: per configuration (x, y) of a stationary shadow: the placements it does not hold
         #: (target and weak visibility region, snap-rounded): see :func:`_union_pieces`
         self._seen: dict[tuple[float, float], shapely.Geometry] = {}
+        #: weak visibility regions computed ahead in a batch (:meth:`_prefetch`), with the
+        #: ``grazing`` mask they were computed with
+        self._weak_pre: dict[tuple[float, float], tuple] = {}
 
     # ------------------------------------------------------------------ anchors
     def pos(self, ids: np.ndarray, q: np.ndarray) -> np.ndarray:
@@ -248,9 +251,12 @@ class Sweeper:
             shadow = snapped(shapely.difference, self.free, area, g)
             self._seen[(float(q[0]), float(q[1]))] = area
         else:
-            reg = weak_visibility(
-                self.env, ring[::-1], np.roll(wanted[::-1], -1), self.eps_aim, self._grazing
-            )
+            pre, grazing = self._weak_pre.pop((float(q[0]), float(q[1])), (None, None))
+            reg = pre if pre is not None and grazing is self._grazing else None
+            if reg is None:
+                reg = weak_visibility(
+                    self.env, ring[::-1], np.roll(wanted[::-1], -1), self.eps_aim, self._grazing
+                )
             # areal(): snap-rounding collapses slivers of the union narrower than the grid
             # into lines, and a snap-rounded overlay refuses mixed-dimension input
             seen = areal(snapped(shapely.union, reg, area, g))
@@ -259,6 +265,28 @@ class Sweeper:
         table = np.vstack([self.env.vert, ring])
         tid = np.concatenate([np.arange(self.n_fixed), ids])
         return polygonal(shadow), table, tid
+
+    def _prefetch(self, qs: list[np.ndarray]) -> None:
+        """The weak visibility regions that :meth:`shadow` needs at the reference points
+        ``qs`` (those not sampled yet), computed in one batch by
+        :func:`~geometry.weak.weak_visibility_many` (bit for bit the regions
+        :func:`~geometry.weak.weak_visibility` gives one by one; the ray casting of all
+        targets together) and kept until :meth:`shadow` takes them."""
+        todo = []
+        for q in qs:
+            key = (float(q[0]), float(q[1]))
+            if key in self._frames or key in self._weak_pre:
+                continue
+            ring, wanted, _ = self.outline(q)
+            if wanted.any():
+                todo.append((key, ring[::-1], np.roll(wanted[::-1], -1)))
+        if len(todo) < 2:
+            return
+        regs = weak_visibility_many(
+            self.env, [r for _, r, _ in todo], [w for _, _, w in todo], self.eps_aim, self._grazing
+        )
+        for (key, _, _), reg in zip(todo, regs, strict=True):
+            self._weak_pre[key] = (reg, self._grazing)
 
     def _edges(self, shadow: shapely.Geometry, table: np.ndarray, tid: np.ndarray) -> list:
         """Edges of ``shadow`` on moving lines: ``(key_prev, key, key_next)``, each
@@ -565,6 +593,7 @@ class Sweeper:
         ev = np.concatenate([[0.0], self._events(q0, dq), [1.0]])
         mids = {float(t) for t in 0.5 * (ev[1:] + ev[:-1])}
         ts = sorted(set(ts) | mids)
+        self._prefetch([q1 if t == 1.0 else q0 + t * dq for t in ts])
         for t in ts:
             frame(t)
         pieces = [frames[t][0] for t in ts]

@@ -261,3 +261,58 @@ def test_uncovered_from_what_the_samples_do_not_hold_equals_uncovered_by_their_u
         )
     # not vacuous: edges were tested, and some of them swept outside the known shadows
     assert calls["n"] > 10 and calls["traced"] > 0
+
+
+def test_batched_weak_visibility_is_the_one_by_one_answer(monkeypatch) -> None:
+    """weak_visibility_many gives, bit for bit, what weak_visibility gives target by
+    target: on the targets a sweep samples (whole outline, and the 5.2 outlines with
+    unwanted pieces) and on targets flush against obstacles (fuzz contact scenes)."""
+    from geometry import recognizable_region
+    from geometry._common import scene_domain
+    from geometry._shapes import ccw_ring
+    from geometry.fuzz import fuzz_scene
+    from geometry.weak import weak_visibility, weak_visibility_many
+
+    calls: list = []
+    orig = S.weak_visibility
+
+    def record(env, ring, wanted, eps=0.0, grazing=None):
+        calls.append((env, ring, wanted, eps, grazing))
+        return orig(env, ring, wanted, eps, grazing)
+
+    monkeypatch.setattr(S, "weak_visibility", record)
+    monkeypatch.setattr(S.Sweeper, "_prefetch", lambda self, qs: None)  # one by one here
+    lab = Scene.load("sensorplan_gym/scenes/lab.json")
+    partial_region(lab, target_in="goal", theta=0.0)
+    recognizable_region(Scene.load("sensorplan_gym/scenes/lab.json"), model="partial", theta=0.0)
+    groups: dict = {}
+    for c in calls:
+        groups.setdefault((id(c[0]), c[3], id(c[4])), []).append(c)
+    cases = [
+        (cs[0][0], [c[1] for c in cs], [c[2] for c in cs], cs[0][3], cs[0][4])
+        for cs in groups.values()
+    ]
+    assert len(cases) >= 2 and sum(len(c[1]) for c in cases) > 20
+    # unwanted pieces (paper 5.2): the same targets with every other edge unwanted
+    env, rings, _, eps, grazing = cases[0]
+    half = [np.arange(len(r)) % 2 == 0 for r in rings]
+    cases.append((env, rings, half, eps, grazing))
+    for seed in range(100000, 100012):
+        d = fuzz_scene(seed, contacts=True)
+        if d is None:
+            continue
+        s = Scene.from_dict({k: v for k, v in d.items() if k != "features"})
+        pts = np.asarray(shapely.get_coordinates(s.goal_geom))[:4]
+        rings = [
+            ccw_ring(s.target_at(x, y, th), clockwise=True) for x, y in pts for th in (0.0, 0.7)
+        ]
+        ones = [np.ones(len(r), dtype=bool) for r in rings]
+        cases += [(scene_domain(s), rings, ones, eps, None) for eps in (0.0, 0.05)]
+    n = 0
+    for env, rings, wanted, eps, grazing in cases:
+        many = weak_visibility_many(env, rings, wanted, eps, grazing)
+        for r, w, got in zip(rings, wanted, many, strict=True):
+            want = weak_visibility(env, r, w, eps, grazing)
+            assert shapely.to_wkb(got) == shapely.to_wkb(want)
+            n += 1
+    assert n > 100
