@@ -512,6 +512,8 @@ def weak_visibility_many(
         g1, off1 = gaps_many_rings(rs, np.concatenate(own1), np.concatenate(q1), extra=_padded(e1))
     row = 0
     qs1 = np.concatenate(q1) if q1 else np.zeros((0, 2))
+    flat = eps_aim == 0  # the fans of all viewpoints at once (_fans_flat)
+    masks = []
     for r, (wnt, dom) in enumerate(zip(wanted, doms, strict=True)):
         if meta1[r] is None:
             continue
@@ -531,7 +533,15 @@ def weak_visibility_many(
                     if arcs is not None:
                         f &= ~_between(arcs[k], mid, float(np.arctan2(along[1], along[0])))
                     front |= f
-            fans[r] += _fans(gi, front & (gi.seg >= 0), dom, eps_aim)
+            if flat:
+                masks.append(front & (gi.seg >= 0))
+            else:
+                fans[r] += _fans(gi, front & (gi.seg >= 0), dom, eps_aim)
+    if flat and masks:
+        got, view = _fans_flat(g1, off1, qs1, np.concatenate(masks), 1e-10 * env.scale)
+        own = np.concatenate(own1)[view]
+        for f, r in zip(got, own.tolist(), strict=True):
+            fans[r].append(f)
     n_direct = [len(f) for f in fans]
     # 2. grazing anchors (weak_visibility, step 2): the directions that see a wanted piece
     q2, s2, e2, own2, meta2 = [], [], [], [], []
@@ -592,9 +602,14 @@ def weak_visibility_many(
         g, off = gaps_many_rings(
             rs, np.asarray(back_own), np.asarray(back_q), sectors=np.asarray(back_sec)
         )
-        for b, r in enumerate(back_own):
-            gb = _slice(g, off[b], off[b + 1], np.asarray(back_q[b]))
-            fans[r] += _fans(gb, gb.seg >= 0, doms[r], eps_aim)
+        if flat:
+            got, view = _fans_flat(g, off, np.asarray(back_q), g.seg >= 0, 1e-10 * env.scale)
+            for f, r in zip(got, np.asarray(back_own)[view].tolist(), strict=True):
+                fans[r].append(f)
+        else:
+            for b, r in enumerate(back_own):
+                gb = _slice(g, off[b], off[b + 1], np.asarray(back_q[b]))
+                fans[r] += _fans(gb, gb.seg >= 0, doms[r], eps_aim)
     out = []
     for r, dom in enumerate(doms):
         arr = np.asarray(fans[r], dtype=object)
@@ -625,3 +640,104 @@ def _slice(g: Gaps, a: int, b: int, q: np.ndarray) -> Gaps:
     """Gaps ``a:b`` of a flat result, with ``q`` (the viewpoint, or one row per gap as in a
     flat result)."""
     return Gaps(q=q, lo=g.lo[a:b], hi=g.hi[a:b], seg=g.seg[a:b], p0=g.p0[a:b], p1=g.p1[a:b])
+
+
+def _runs_flat(g: Gaps, off: np.ndarray, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_runs` of every viewpoint of a flat result at once (viewpoint ``v`` owns gaps
+    ``off[v]:off[v + 1]``): the gap indices of all runs, run after run in the order
+    :func:`_runs` lists them viewpoint by viewpoint, and the (R + 1,) offsets of the
+    runs in that array."""
+    idx = np.flatnonzero(mask)
+    if len(idx) == 0:
+        return idx, np.zeros(1, dtype=np.int64)
+    n_v = len(off) - 1
+    owner = np.repeat(np.arange(n_v), np.diff(off))
+    o = owner[idx]
+    new = np.ones(len(idx), dtype=bool)
+    new[1:] = (o[1:] != o[:-1]) | ~(np.abs(g.lo[idx[1:]] - g.hi[idx[:-1]]) <= 1e-12)
+    run = np.cumsum(new) - 1
+    n_runs = np.bincount(o, weights=new, minlength=n_v).astype(np.int64)
+    # a viewpoint whose gaps close the circle, masked at both ends, with several runs:
+    # its last run continues into its first (listed first, last run's gaps before)
+    has = np.diff(off) > 0
+    first = np.where(has, off[:-1], 0)
+    last = np.where(has, off[1:] - 1, 0)
+    closed = has & (np.abs(g.hi[last] - g.lo[first] - TAU) <= 1e-12)
+    merge = closed & mask[first] & mask[last] & (n_runs > 1)
+    starts = np.flatnonzero(new)
+    rv = o[starts]  # viewpoint of each run
+    run_first = np.full(n_v, -1, dtype=np.int64)
+    run_last = np.full(n_v, -1, dtype=np.int64)
+    u, at = np.unique(rv, return_index=True)  # runs are in viewpoint order
+    run_first[u] = at
+    run_last[u] = np.concatenate([at[1:], [len(rv)]]) - 1
+    in_last = merge[o] & (run == run_last[o])
+    label = np.where(in_last, run_first[o], run)
+    order = np.lexsort((np.arange(len(idx)), ~in_last, o))
+    label = label[order]
+    bounds = np.flatnonzero(np.concatenate([[True], label[1:] != label[:-1], [True]]))
+    return idx[order], bounds
+
+
+def _fans_flat(g: Gaps, off: np.ndarray, q: np.ndarray, mask: np.ndarray, tol: float) -> tuple:
+    """:func:`_fans` with ``eps_aim == 0`` for every viewpoint of a flat result at once
+    (viewpoint ``v``, at ``q[v]``, owns gaps ``off[v]:off[v + 1]``): the fans, in the
+    order :func:`_fans` gives them viewpoint by viewpoint, and the viewpoint of each.
+    The same points are kept and :func:`geometry._vis.clean_polygon`'s rule is applied
+    to each ring (``tol``: its tolerance), so every polygon is the one :func:`_fans`
+    builds."""
+    gi, bounds = _runs_flat(g, off, mask)
+    n_runs = len(bounds) - 1
+    if n_runs == 0:
+        return [], np.zeros(0, dtype=np.int64)
+    owner = np.repeat(np.arange(len(off) - 1), np.diff(off))
+    ln = np.diff(bounds)
+    rid = np.repeat(np.arange(n_runs), ln)
+    m = np.arange(len(gi)) - bounds[rid]
+    seg = g.seg[gi]
+    same_next = np.zeros(len(gi), dtype=bool)
+    same_next[:-1] = seg[1:] == seg[:-1]
+    same_next &= m < ln[rid] - 1
+    same_prev = np.zeros(len(gi), dtype=bool)
+    same_prev[1:] = seg[1:] == seg[:-1]
+    same_prev &= m > 0
+    # per run: the viewpoint, then p0 and p1 of each gap
+    base = np.arange(n_runs) + 2 * bounds[:-1]
+    total = n_runs + 2 * len(gi)
+    pts = np.empty((total, 2))
+    keep = np.empty(total, dtype=bool)
+    ring = np.empty(total, dtype=np.int64)
+    view = owner[gi[bounds[:-1]]]
+    pts[base] = q[view]
+    keep[base] = True
+    ring[base] = np.arange(n_runs)
+    at0 = base[rid] + 1 + 2 * m
+    pts[at0], keep[at0], ring[at0] = g.p0[gi], ~same_prev, rid
+    pts[at0 + 1], keep[at0 + 1], ring[at0 + 1] = g.p1[gi], ~same_next, rid
+    pts, ring = pts[keep], ring[keep]
+    # clean_polygon: drop the points within tol of their successor (around the ring)
+    cnt = np.bincount(ring, minlength=n_runs)
+    start = np.concatenate([[0], np.cumsum(cnt)])
+    nxt = np.arange(1, len(pts) + 1)
+    ends = start[1:] - 1
+    nxt[ends[cnt > 0]] = start[:-1][cnt > 0]
+    step = np.abs(pts[nxt] - pts).max(axis=1)
+    ok = step > tol
+    pts, ring = pts[ok], ring[ok]
+    cnt = np.bincount(ring, minlength=n_runs)
+    out = np.empty(n_runs, dtype=object)
+    small = cnt < 3
+    out[small] = [shapely.Polygon() for _ in range(int(small.sum()))]
+    big = np.flatnonzero(~small)
+    if len(big):
+        sel = ~small[ring]
+        renum = np.cumsum(~small) - 1
+        rings = shapely.linearrings(pts[sel], indices=renum[ring[sel]])
+        polys = shapely.polygons(rings)
+        bad = ~shapely.is_valid(polys)
+        for b in np.flatnonzero(bad):  # clean_polygon's repair
+            parts = shapely.get_parts(shapely.make_valid(polys[b]))
+            parts = parts[np.isin(shapely.get_type_id(parts), (3, 6))]
+            polys[b] = shapely.union_all(parts) if len(parts) else shapely.Polygon()
+        out[big] = polys
+    return list(out), view
