@@ -172,6 +172,7 @@ class Sweeper:
         #: weak visibility regions computed ahead in a batch (:meth:`_prefetch`), with the
         #: ``grazing`` mask they were computed with
         self._weak_pre: dict[tuple[float, float], tuple] = {}
+        self._eroded_pre: dict[tuple, shapely.Geometry] = {}
 
     # ------------------------------------------------------------------ anchors
     def pos(self, ids: np.ndarray, q: np.ndarray) -> np.ndarray:
@@ -902,24 +903,31 @@ class Sweeper:
         detected by it."""
         todo = [(a, b, 0) for a, b in zip(ts[:-1], ts[1:], strict=True)]
         out = set(ts)
+        # level by level (each decision depends on its interval alone, so the order does
+        # not matter): the eroded targets' regions of a level, then its new samples, are
+        # computed in one batch each
         while todo:
             self._check_time()
-            a, b, depth = todo.pop()
-            if depth >= self.max_depth:
-                continue
-            upper = self._eroded_shadow(q0 + a * dq, q0 + b * dq)
-            if upper is None:
-                new = True
-            else:
-                parts = shapely.get_parts(upper)
-                parts = parts[~shapely.is_empty(parts)]  # an empty shadow is no new component
-                # meets the union of the two shadows = meets one of them (no overlay)
-                meets = np.zeros(len(parts), dtype=bool)
-                for k in (frame(a)[0], frame(b)[0]):
-                    meets |= shapely.intersects(parts, k)
-                new = bool((~meets).any())
-            if new:
-                m = 0.5 * (a + b)
+            level = [(a, b, depth) for a, b, depth in todo if depth < self.max_depth]
+            self._prefetch_eroded([(q0 + a * dq, q0 + b * dq) for a, b, _ in level])
+            todo, mids = [], []
+            for a, b, depth in level:
+                self._check_time()
+                upper = self._eroded_shadow(q0 + a * dq, q0 + b * dq)
+                if upper is None:
+                    new = True
+                else:
+                    parts = shapely.get_parts(upper)
+                    parts = parts[~shapely.is_empty(parts)]  # an empty shadow: no new component
+                    # meets the union of the two shadows = meets one of them (no overlay)
+                    meets = np.zeros(len(parts), dtype=bool)
+                    for k in (frame(a)[0], frame(b)[0]):
+                        meets |= shapely.intersects(parts, k)
+                    new = bool((~meets).any())
+                if new:
+                    mids.append((a, 0.5 * (a + b), b, depth))
+            self._prefetch([q0 + m * dq for _, m, _, _ in mids])
+            for a, m, b, depth in mids:
                 frame(m)
                 out.add(m)
                 stats["refined"] += 1
@@ -930,6 +938,23 @@ class Sweeper:
         """Shadow of the part of A common to all A_q, q in [qa, qb] (it contains
         every S(q) there); None when that part is empty."""
 
+        got = self._eroded_core(qa, qb)
+        if got is None:
+            return None
+        core, ring = got
+        reg = self._eroded_pre.pop((tuple(qa.tolist()), tuple(qb.tolist())), None)
+        if reg is None:
+            reg = weak_visibility(
+                self.env, ring, np.ones(len(ring), dtype=bool), self.eps_aim, self._anchors()
+            )
+        g = self.shadow_grid  # as in shadow(): the region's hole nearly coincides with core
+        # snap-rounding can raise "Ring edge missing" at scale 1e-3 (fuzz seed 201039, --swept)
+        seen = areal(snapped(shapely.union, reg, core, g))
+        return polygonal(snapped(shapely.difference, self.free, seen, g))
+
+    def _eroded_core(self, qa: np.ndarray, qb: np.ndarray) -> tuple | None:
+        """The part of A common to all A_q, q in [qa, qb] (its largest piece) and its
+        outline (clockwise), or None when it is empty (:meth:`_eroded_shadow`)."""
         aa = shapely.Polygon(self.ring0 + qa)
         ab = shapely.Polygon(self.ring0 + qb)
         core = shapely.intersection(aa, ab)
@@ -943,13 +968,23 @@ class Sweeper:
         parts = shapely.get_parts(core)
         core = parts[np.argmax(shapely.area(parts))]
         ring = np.asarray(shapely.orient_polygons(core, exterior_cw=True).exterior.coords)[:-1]
-        reg = weak_visibility(
-            self.env, ring, np.ones(len(ring), dtype=bool), self.eps_aim, self._anchors()
-        )
-        g = self.shadow_grid  # as in shadow(): the region's hole nearly coincides with core
-        # snap-rounding can raise "Ring edge missing" at scale 1e-3 (fuzz seed 201039, --swept)
-        seen = areal(snapped(shapely.union, reg, core, g))
-        return polygonal(snapped(shapely.difference, self.free, seen, g))
+        return core, ring
+
+    def _prefetch_eroded(self, pairs: list[tuple[np.ndarray, np.ndarray]]) -> None:
+        """The weak visibility regions that :meth:`_eroded_shadow` needs for the intervals
+        ``pairs`` ((qa, qb) each), in one batch (:meth:`_prefetch`); kept until taken."""
+        todo = []
+        for qa, qb in pairs:
+            got = self._eroded_core(qa, qb)
+            if got is not None:
+                todo.append(((tuple(qa.tolist()), tuple(qb.tolist())), got[1]))
+        if len(todo) < 2:
+            return
+        rings = [r for _, r in todo]
+        ones = [np.ones(len(r), dtype=bool) for r in rings]
+        regs = weak_visibility_many(self.env, rings, ones, self.eps_aim, self._anchors())
+        for (key, _), reg in zip(todo, regs, strict=True):
+            self._eroded_pre[key] = reg
 
     def _trace_many(self, edges: list, ta: float, tb: float, q0, dq) -> tuple[list, list]:
         """Areas swept by moving shadow edges found at sample ``ta`` while they live
@@ -1389,6 +1424,10 @@ def swept_shadows(
                 np.asarray(ring.coords)[:-1, :2], np.asarray(ring.coords)[1:, :2], strict=True
             )
         ]
+        # the samples at the vertices of the region's boundary in one batch (along() sets
+        # the same grazing mask)
+        sw._grazing = sw._anchors()
+        sw._prefetch([np.asarray(a, dtype=float) for a, _ in segs])
         for done, (a, b) in enumerate(segs):
             try:
                 got, st = sw.along(a, b)
