@@ -579,24 +579,29 @@ def weak_visibility_many(
             extra=_padded(e2),
         )  # fmt: skip
         at = np.cumsum([0] + [len(x) for x in q2])
+        sees = np.zeros(len(g.lo), dtype=bool)
         for b, r in enumerate(np.concatenate(own2)[at[:-1]]):
             v, arcs = meta2[r]
             lo_v, hi_v = at[b], at[b + 1]
             if off[hi_v] == off[lo_v]:
                 continue
-            gr = _slice(g, off[lo_v], off[hi_v], g.q[off[lo_v] : off[hi_v]])  # q per gap
-            off_r = off[lo_v : hi_v + 1] - off[lo_v]
-            dom = doms[r]
-            sees = (gr.seg >= 0) & (dom.seg_tag[np.maximum(gr.seg, 0)] == WANTED)
+            g0, g1_ = off[lo_v], off[hi_v]
+            seg = g.seg[g0:g1_]
+            s_ = (seg >= 0) & (doms[r].seg_tag[np.maximum(seg, 0)] == WANTED)
             if arcs is not None:
-                owner = np.searchsorted(off_r, np.arange(len(gr.lo)), side="right") - 1
-                sees &= _grazes(arcs[owner], 0.5 * (gr.lo + gr.hi))
-            for k in np.unique(np.searchsorted(off_r, np.flatnonzero(sees), side="right") - 1):
-                gk = gr.part(off_r[k], off_r[k + 1])
-                for run in _runs(gk, sees[off_r[k] : off_r[k + 1]]):
-                    back_q.append(v[k])
-                    back_sec.append((gk.lo[run[0]] + np.pi, _width(gk, run)))
-                    back_own.append(r)
+                owner = np.searchsorted(off[lo_v : hi_v + 1] - g0, np.arange(g1_ - g0), "right") - 1
+                s_ &= _grazes(arcs[owner], 0.5 * (g.lo[g0:g1_] + g.hi[g0:g1_]))
+            sees[g0:g1_] = s_
+        gi, bounds = _runs_flat(g, off, sees)
+        if len(bounds) > 1:
+            first, last = gi[bounds[:-1]], gi[bounds[1:] - 1]
+            view = np.searchsorted(off, first, side="right") - 1
+            width = (g.hi[last] - g.lo[first]) % TAU
+            width = np.where(width == 0.0, TAU, width)  # _width
+            vs, owns = np.concatenate(q2), np.concatenate(own2)
+            back_q = list(vs[view])
+            back_sec = list(zip((g.lo[first] + np.pi).tolist(), width.tolist(), strict=True))
+            back_own = owns[view].tolist()
     # ... then the placements on the opposite side of v
     if back_q:
         g, off = gaps_many_rings(
