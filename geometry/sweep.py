@@ -1449,6 +1449,7 @@ def swept_shadows(
         else:
             samples.extend((np.array(k) - c, v[0]) for k, v in sw._frames.items())
             ts = np.arange(1, extra_samples + 1) / (extra_samples + 1)
+            sw._prefetch([a + t * (b - a) for a, b in segs for t in ts])  # one batch
             for a, b in segs:
                 for t in ts:
                     q = a + t * (b - a)
