@@ -36,9 +36,11 @@ class RayEscapeError(RuntimeError):
 __all__ = [
     "Domain",
     "Gaps",
+    "RingSet",
     "domain_from_geometry",
     "gaps_from",
     "gaps_many",
+    "gaps_many_rings",
     "polygon_from_gaps",
     "visibility_polygon",
 ]
@@ -372,3 +374,191 @@ def clean_polygon(pts: np.ndarray, tol: float) -> shapely.Geometry:
 def visibility_polygon(dom: Domain, q: np.ndarray) -> shapely.Polygon:
     """Visibility polygon V(q) of a point in the domain (world frame)."""
     return polygon_from_gaps(gaps_from(dom, q))
+
+
+@dataclass(frozen=True)
+class RingSet:
+    """One base domain and several rings, each of which extends it as
+    :meth:`Domain.with_ring` does (``doms[r]``): the per-ring arrays padded (NaN) to the
+    longest ring, for :func:`gaps_many_rings`."""
+
+    base: Domain
+    doms: list
+    seg: np.ndarray  # (R, K, 4)
+    vert: np.ndarray  # (R, K, 2)
+    wedge: np.ndarray  # (R, K, 2): Domain.vert_wedge of the ring's vertices
+    n: np.ndarray  # (R,) vertices (= segments) per ring
+
+    @staticmethod
+    def of(base: Domain, doms: list) -> RingSet:
+        """The ring set of domains ``doms``, each ``base.with_ring(...)``."""
+        nb = len(base.seg)
+        n = np.array([len(d.seg) - nb for d in doms], dtype=np.int64)
+        k = max(1, int(n.max(initial=0)))
+        seg = np.full((len(doms), k, 4), np.nan)
+        vert = np.full((len(doms), k, 2), np.nan)
+        wedge = np.full((len(doms), k, 2), np.nan)
+        for r, d in enumerate(doms):
+            seg[r, : n[r]] = d.seg[nb:]
+            vert[r, : n[r]] = d.vert[nb:]
+            wedge[r, : n[r]] = _wedge(d.vert[nb:], d.vert_prev[nb:], d.vert_next[nb:])
+        return RingSet(base, list(doms), seg, vert, wedge, n)
+
+
+def _wedge(vert: np.ndarray, prev: np.ndarray, nxt: np.ndarray) -> np.ndarray:
+    """:attr:`Domain.vert_wedge` of the vertices ``vert`` (the same expression, row by
+    row)."""
+    a = _libm.atan2(nxt[:, 1] - vert[:, 1], nxt[:, 0] - vert[:, 0])
+    b = _libm.atan2(prev[:, 1] - vert[:, 1], prev[:, 0] - vert[:, 0])
+    w = (b - a) % TAU
+    return np.stack([a, np.where(w == 0.0, TAU, w)], axis=1)
+
+
+def _blocking_rings(rs: RingSet, dom_of: np.ndarray, q: np.ndarray) -> tuple:
+    """:func:`geometry.visindex.blocking` of each viewpoint ``q[i]`` in its own domain
+    ``rs.doms[dom_of[i]]``, for all at once (the same pairs, in the same order, and the
+    same expressions row by row)."""
+    base = rs.base
+    nb = len(base.seg)
+    tol = 1e-12 * base.scale
+    n = len(q)
+    w1 = np.full((n, 2), np.nan)
+    w2 = np.full((n, 2), np.nan)
+    along = np.full((n, 2), np.nan)
+    rows, cols = _visindex.near_pairs(base, q, 2.0 * tol)
+    # the rings' segments, by brute force (as near_pairs does for an extended domain)
+    ex = rs.seg[dom_of]  # (n, K, 4)
+    a = q[:, None, :] - ex[:, :, :2]
+    e = ex[:, :, 2:] - ex[:, :, :2]
+    L2 = np.maximum((e * e).sum(axis=2), 1e-300)
+    with np.errstate(invalid="ignore"):
+        t = np.clip((a * e).sum(axis=2) / L2, 0.0, 1.0)
+        d = a - t[..., None] * e
+        r2, c2 = np.nonzero((d * d).sum(axis=2) <= (2.0 * tol) * (2.0 * tol))
+    rows = np.concatenate([rows, r2])
+    cols = np.concatenate([cols, c2 + nb])
+    order = np.lexsort((cols, rows))
+    rows, cols = rows[order], cols[order]
+    if len(rows) == 0:
+        return w1, w2, along
+    ring = cols >= nb
+    k = np.where(ring, cols - nb, 0)
+    own = dom_of[rows]
+    vert = np.where(ring[:, None], rs.vert[own, k], base.vert[np.where(ring, 0, cols)])
+    segs = np.where(ring[:, None], rs.seg[own, k], base.seg[np.where(ring, 0, cols)])
+    vnear = np.abs(vert - q[rows]).max(axis=1) <= tol
+    r, c = rows[vnear], cols[vnear]
+    if len(r):
+        env_wedge = _base_wedge(base)
+        rv, kv = ring[vnear], k[vnear]
+        wedge = np.where(rv[:, None], rs.wedge[own[vnear], kv], env_wedge[np.where(rv, 0, c)])
+        first = np.concatenate([[True], r[1:] != r[:-1]])
+        w1[r[first]] = wedge[first]
+        second = ~first & np.concatenate([[False], first[:-1]])
+        w2[r[second]] = wedge[second]
+    e = segs[:, 2:] - segs[:, :2]
+    L = np.hypot(e[:, 0], e[:, 1])
+    a = q[rows] - segs[:, :2]
+    dist = np.abs(e[:, 0] * a[:, 1] - e[:, 1] * a[:, 0]) / np.maximum(L, 1e-300)
+    t = (a[:, 0] * e[:, 0] + a[:, 1] * e[:, 1]) / np.maximum(L * L, 1e-300)
+    on = (dist <= tol) & (t * L > tol) & ((1 - t) * L > tol)
+    along[rows[on]] = e[on]
+    return w1, w2, along
+
+
+def _base_wedge(base: Domain) -> np.ndarray:
+    """``base.vert_wedge``, kept on the domain."""
+    got = getattr(base, "_wedge_cache", None)
+    if got is None:
+        got = base.vert_wedge
+        object.__setattr__(base, "_wedge_cache", got)
+    return got
+
+
+def gaps_many_rings(
+    rs: RingSet,
+    dom_of: np.ndarray,
+    q: np.ndarray,
+    *,
+    sectors: np.ndarray | None = None,
+    extra: np.ndarray | None = None,
+) -> tuple[Gaps, np.ndarray]:
+    """:func:`gaps_many` (``flat=True``) for viewpoints in different domains: ``q[i]`` is
+    seen in ``rs.doms[dom_of[i]]`` (the base domain extended by one ring).  Segment
+    indices are each domain's own.  The answers are bit for bit those of
+    :func:`gaps_many` on each domain: the base's vertices are sorted by the compiled
+    kernel as there, and a ring's vertices join as critical directions computed by the
+    same expressions (:func:`geometry._libm.atan2`, the same tolerance drop); the first
+    hits come from :func:`geometry.visindex.first_hits_rings`.  Needs the compiled index
+    (:func:`geometry.visindex.available`)."""
+    base = rs.base
+    nb = len(base.seg)
+    q = np.asarray(q, dtype=float).reshape(-1, 2)
+    dom_of = np.asarray(dom_of, dtype=np.int64)
+    n = len(q)
+    tol = 1e-12 * base.scale
+    start = np.zeros(n)
+    width = np.full(n, TAU)
+    if sectors is not None:
+        has = ~np.isnan(sectors[:, 0])
+        start[has] = sectors[has, 0]
+        width[has] = np.minimum(sectors[has, 1], TAU)
+    w1, w2, along = _blocking_rings(rs, dom_of, q)
+    cols = [] if extra is None else [extra]
+    cols.append(
+        np.stack(
+            [
+                w1[:, 0],
+                w1[:, 0] + w1[:, 1],
+                w2[:, 0],
+                w2[:, 0] + w2[:, 1],
+                _libm.atan2(along[:, 1], along[:, 0]),
+                _libm.atan2(-along[:, 1], -along[:, 0]),
+            ],
+            axis=1,
+        )
+    )
+    # the ring's vertices: directions as the kernel computes them for a domain's vertex
+    rv = rs.vert[dom_of]  # (n, K, 2)
+    dx = rv[..., 0] - q[:, None, 0]
+    dy = rv[..., 1] - q[:, None, 1]
+    with np.errstate(invalid="ignore"):
+        ang = _libm.atan2(dy, dx)
+        ang[~(np.maximum(np.abs(dx), np.abs(dy)) > tol)] = np.nan  # near q, or padding
+    cols.append(ang)
+    crit = np.concatenate(cols, axis=1)
+    owner, lo, hi = _visindex.sorted_gaps(q, start, width, base.vert, crit, tol, False, base)
+    mid = 0.5 * (lo + hi)
+    open_ = np.ones(len(mid), dtype=bool)
+    for w in (w1, w2):
+        w0 = w[owner, 0]
+        with np.errstate(invalid="ignore"):
+            open_ &= np.isnan(w0) | (((mid - w0) % TAU) < w[owner, 1])
+    ax, ay = along[owner, 0], along[owner, 1]
+    with np.errstate(invalid="ignore"):
+        open_ &= np.isnan(ax) | (ax * _libm.sin(mid) - ay * _libm.cos(mid) >= 0)
+    qo = q[owner]
+    do = dom_of[owner]
+    seg = np.full(len(mid), -1, dtype=np.int64)
+    idx = np.flatnonzero(open_)
+    if len(idx):
+        j = _visindex.first_hits_rings(base, rs.seg, rs.n, do[idx], qo[idx], mid[idx])
+        lost = np.flatnonzero(j < 0)
+        for r in np.unique(do[idx[lost]]):  # as _first_hits does: brute force, per domain
+            sel = lost[do[idx[lost]] == r]
+            j[sel] = _first_hits(rs.doms[r], qo[idx[sel]], mid[idx[sel]], brute=True)
+        seg[idx] = j
+    p0 = qo.copy()
+    p1 = qo.copy()
+    ok = seg >= 0
+    if ok.any():
+        s_ok, d_ok = seg[ok], do[ok]
+        ring = s_ok >= nb
+        sg = np.where(
+            ring[:, None],
+            rs.seg[d_ok, np.where(ring, s_ok - nb, 0)],
+            base.seg[np.where(ring, 0, s_ok)],
+        )
+        p0[ok] = _ray_line(qo[ok], lo[ok], sg)
+        p1[ok] = _ray_line(qo[ok], hi[ok], sg)
+    return Gaps(q=qo, lo=lo, hi=hi, seg=seg, p0=p0, p1=p1), np.searchsorted(owner, np.arange(n + 1))

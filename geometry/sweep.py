@@ -66,7 +66,7 @@ from ._shapes import cross as _cross
 from ._vis import TAU, Domain, RayEscapeError, gaps_many
 from .weak import ENV as _ENV
 from .weak import WANTED as _WANTED
-from .weak import weak_visibility
+from .weak import weak_visibility, weak_visibility_many
 
 #: The union of the pieces is snap-rounded onto a grid of ``2**-GRID_BITS`` of the scene's
 #: size (about 1e-12): see :func:`swept_shadows`.
@@ -166,6 +166,13 @@ class Sweeper:
         self.shadow_grid = math.ldexp(self.grid, -SHADOW_BITS)
         #: the ``grazing`` anchors of the stationary shadows (None: all; same answer)
         self._grazing: np.ndarray | None = None
+        #: per configuration (x, y) of a stationary shadow: the placements it does not hold
+        #: (target and weak visibility region, snap-rounded): see :func:`_union_pieces`
+        self._seen: dict[tuple[float, float], shapely.Geometry] = {}
+        #: weak visibility regions computed ahead in a batch (:meth:`_prefetch`), with the
+        #: ``grazing`` mask they were computed with
+        self._weak_pre: dict[tuple[float, float], tuple] = {}
+        self._eroded_pre: dict[tuple, shapely.Geometry] = {}
 
     # ------------------------------------------------------------------ anchors
     def pos(self, ids: np.ndarray, q: np.ndarray) -> np.ndarray:
@@ -243,17 +250,44 @@ class Sweeper:
         g = self.shadow_grid
         if not wanted.any():
             shadow = snapped(shapely.difference, self.free, area, g)
+            self._seen[(float(q[0]), float(q[1]))] = area
         else:
-            reg = weak_visibility(
-                self.env, ring[::-1], np.roll(wanted[::-1], -1), self.eps_aim, self._grazing
-            )
+            pre, grazing = self._weak_pre.pop((float(q[0]), float(q[1])), (None, None))
+            reg = pre if pre is not None and grazing is self._grazing else None
+            if reg is None:
+                reg = weak_visibility(
+                    self.env, ring[::-1], np.roll(wanted[::-1], -1), self.eps_aim, self._grazing
+                )
             # areal(): snap-rounding collapses slivers of the union narrower than the grid
             # into lines, and a snap-rounded overlay refuses mixed-dimension input
             seen = areal(snapped(shapely.union, reg, area, g))
             shadow = snapped(shapely.difference, self.free, seen, g)
+            self._seen[(float(q[0]), float(q[1]))] = seen
         table = np.vstack([self.env.vert, ring])
         tid = np.concatenate([np.arange(self.n_fixed), ids])
         return polygonal(shadow), table, tid
+
+    def _prefetch(self, qs: list[np.ndarray]) -> None:
+        """The weak visibility regions that :meth:`shadow` needs at the reference points
+        ``qs`` (those not sampled yet), computed in one batch by
+        :func:`~geometry.weak.weak_visibility_many` (bit for bit the regions
+        :func:`~geometry.weak.weak_visibility` gives one by one; the ray casting of all
+        targets together) and kept until :meth:`shadow` takes them."""
+        todo = []
+        for q in qs:
+            key = (float(q[0]), float(q[1]))
+            if key in self._frames or key in self._weak_pre:
+                continue
+            ring, wanted, _ = self.outline(q)
+            if wanted.any():
+                todo.append((key, ring[::-1], np.roll(wanted[::-1], -1)))
+        if len(todo) < 2:
+            return
+        regs = weak_visibility_many(
+            self.env, [r for _, r, _ in todo], [w for _, _, w in todo], self.eps_aim, self._grazing
+        )
+        for (key, _, _), reg in zip(todo, regs, strict=True):
+            self._weak_pre[key] = (reg, self._grazing)
 
     def _edges(self, shadow: shapely.Geometry, table: np.ndarray, tid: np.ndarray) -> list:
         """Edges of ``shadow`` on moving lines: ``(key_prev, key, key_next)``, each
@@ -560,6 +594,7 @@ class Sweeper:
         ev = np.concatenate([[0.0], self._events(q0, dq), [1.0]])
         mids = {float(t) for t in 0.5 * (ev[1:] + ev[:-1])}
         ts = sorted(set(ts) | mids)
+        self._prefetch([q1 if t == 1.0 else q0 + t * dq for t in ts])
         for t in ts:
             frame(t)
         pieces = [frames[t][0] for t in ts]
@@ -574,9 +609,13 @@ class Sweeper:
             # the areal part: GEOS's union of two nearly coincident shadows can carry
             # collapsed edges (LineStrings), and an overlay with such a collection fails
             # ("Result area inconsistent with overlay operation", fuzz seed 501057)
-            known = areal(shapely.union(frame(a)[0], frame(b)[0]))
+            known = None  # the shadows' union, only if their X (see _uncovered_seen) is not kept
             for t, toward in ((a, b), (b, a)):
-                edges = self._uncovered(frame(t)[1], t, toward, known, q0, dq)
+                edges = self._uncovered_seen(frame(t)[1], t, toward, (a, b), q0, q1)
+                if edges is None:
+                    if known is None:
+                        known = areal(shapely.union(frame(a)[0], frame(b)[0]))
+                    edges = self._uncovered(frame(t)[1], t, toward, known, q0, dq)
                 for e in frame(t)[1]:
                     if e not in edges:  # swept inside the known shadows: nothing to trace
                         cover.setdefault(e[1], []).append((a, b))
@@ -757,6 +796,77 @@ class Sweeper:
         need = ~ok | (rest > 1e-9 * self.env.scale**2)
         return [e for e, n_ in zip(edges, need, strict=True) if n_]
 
+    def _uncovered_seen(
+        self, edges: list, t: float, toward: float, ab: tuple[float, float], q0, q1
+    ) -> list | None:
+        """:meth:`_uncovered` for the shadows ``S_a``, ``S_b`` at the sample times ``ab``
+        from what they do not hold, ``X_a`` and ``X_b`` (:meth:`shadow`); None when one
+        of them was not kept (the caller then unites the shadows).
+
+        ``S_a u S_b = F - (X_a n X_b)`` (``F`` the free space), so the part of a quad
+        outside the known shadows is ``(quad - F) u (quad n X_a n X_b)``: one
+        intersection of the two small sets (near the region, kept for :func:`_union_pieces`)
+        instead of the union of two whole-map shadows, and the small quads cut by it.
+        ``quad - F`` is left out where the quad lies in ``F`` grown by ``1e-12`` of the
+        scene's size (a prepared test): its area there is below ``_free_band`` (that
+        width times ``F``'s perimeter), which the threshold is lowered by, so no sweep
+        that :meth:`_uncovered` would trace is dropped; ``quad n X_a n X_b`` is not cut by
+        ``F`` (that area is only larger)."""
+        if not edges:
+            return []
+        ka, kb = (self._frame_key(q0, q1, u) for u in ab)
+        inter = self._seen_pair(ka, kb)
+        if inter is None:
+            return None
+        dq = q1 - q0
+        vs, ve = self._ends_many(edges, np.array([[t, toward]]), q0, dq)  # (E, 2, 2) each
+        quads = np.stack([vs[:, 0], vs[:, 1], ve[:, 1], ve[:, 0]], axis=1)
+        ok = np.isfinite(quads).all(axis=(1, 2))
+        polys = shapely.make_valid(shapely.polygons(np.where(ok[:, None, None], quads, 0.0)))
+        grown, band = self._free_grown_eps()
+        rest = np.zeros(len(polys))
+        idx = np.flatnonzero(ok)
+        meets = shapely.intersects(inter, polys[idx])
+        rest[idx[meets]] = shapely.area(shapely.intersection(polys[idx[meets]], inter))
+        out = idx[~shapely.covers(grown, polys[idx])]
+        if len(out):
+            rest[out] += shapely.area(shapely.difference(polys[out], self.free))
+        need = ~ok | (rest > 1e-9 * self.env.scale**2 - band)
+        return [e for e, n_ in zip(edges, need, strict=True) if n_]
+
+    @staticmethod
+    def _frame_key(q0: np.ndarray, q1: np.ndarray, t: float) -> tuple[float, float]:
+        """The key of the sample at time ``t`` of the sweep ``q0 -> q1`` in ``_frames``
+        and ``_seen`` (as :meth:`along` computes it)."""
+        q = q1 if t == 1.0 else q0 + t * (q1 - q0)
+        return (float(q[0]), float(q[1]))
+
+    def _seen_pair(self, ka: tuple, kb: tuple) -> shapely.Geometry | None:
+        """``X_a n X_b`` for the samples at ``ka``, ``kb`` (snap-rounded on ``grid``,
+        prepared, cached: :func:`_union_pieces` starts from these); None when one of them
+        was not kept."""
+        pairs = self.__dict__.setdefault("_pairs", {})
+        got = pairs.get((ka, kb))
+        if got is None:
+            xa, xb = self._seen.get(ka), self._seen.get(kb)
+            if xa is None or xb is None:
+                return None
+            got = pairs[(ka, kb)] = areal(snapped(shapely.intersection, xa, xb, self.grid))
+            shapely.prepare(got)
+        return got
+
+    def _free_grown_eps(self) -> tuple[shapely.Geometry, float]:
+        """The free space grown by ``1e-12`` of the scene's size (prepared) and a bound on
+        the area of that band (the width times the free space's perimeter, doubled),
+        cached."""
+        got = getattr(self, "_free_eps", None)
+        if got is None:
+            eps = 1e-12 * self.env.scale
+            grown = shapely.buffer(self.free, eps)
+            shapely.prepare(grown)
+            got = self._free_eps = (grown, 2.0 * eps * float(shapely.length(self.free)))
+        return got
+
     def _coverage_gap(
         self, ea: list, eb: list, cover: dict, a: float, b: float, confirmed: set
     ) -> float | None:
@@ -793,24 +903,31 @@ class Sweeper:
         detected by it."""
         todo = [(a, b, 0) for a, b in zip(ts[:-1], ts[1:], strict=True)]
         out = set(ts)
+        # level by level (each decision depends on its interval alone, so the order does
+        # not matter): the eroded targets' regions of a level, then its new samples, are
+        # computed in one batch each
         while todo:
             self._check_time()
-            a, b, depth = todo.pop()
-            if depth >= self.max_depth:
-                continue
-            upper = self._eroded_shadow(q0 + a * dq, q0 + b * dq)
-            if upper is None:
-                new = True
-            else:
-                parts = shapely.get_parts(upper)
-                parts = parts[~shapely.is_empty(parts)]  # an empty shadow is no new component
-                # meets the union of the two shadows = meets one of them (no overlay)
-                meets = np.zeros(len(parts), dtype=bool)
-                for k in (frame(a)[0], frame(b)[0]):
-                    meets |= shapely.intersects(parts, k)
-                new = bool((~meets).any())
-            if new:
-                m = 0.5 * (a + b)
+            level = [(a, b, depth) for a, b, depth in todo if depth < self.max_depth]
+            self._prefetch_eroded([(q0 + a * dq, q0 + b * dq) for a, b, _ in level])
+            todo, mids = [], []
+            for a, b, depth in level:
+                self._check_time()
+                upper = self._eroded_shadow(q0 + a * dq, q0 + b * dq)
+                if upper is None:
+                    new = True
+                else:
+                    parts = shapely.get_parts(upper)
+                    parts = parts[~shapely.is_empty(parts)]  # an empty shadow: no new component
+                    # meets the union of the two shadows = meets one of them (no overlay)
+                    meets = np.zeros(len(parts), dtype=bool)
+                    for k in (frame(a)[0], frame(b)[0]):
+                        meets |= shapely.intersects(parts, k)
+                    new = bool((~meets).any())
+                if new:
+                    mids.append((a, 0.5 * (a + b), b, depth))
+            self._prefetch([q0 + m * dq for _, m, _, _ in mids])
+            for a, m, b, depth in mids:
                 frame(m)
                 out.add(m)
                 stats["refined"] += 1
@@ -821,6 +938,23 @@ class Sweeper:
         """Shadow of the part of A common to all A_q, q in [qa, qb] (it contains
         every S(q) there); None when that part is empty."""
 
+        got = self._eroded_core(qa, qb)
+        if got is None:
+            return None
+        core, ring = got
+        reg = self._eroded_pre.pop((tuple(qa.tolist()), tuple(qb.tolist())), None)
+        if reg is None:
+            reg = weak_visibility(
+                self.env, ring, np.ones(len(ring), dtype=bool), self.eps_aim, self._anchors()
+            )
+        g = self.shadow_grid  # as in shadow(): the region's hole nearly coincides with core
+        # snap-rounding can raise "Ring edge missing" at scale 1e-3 (fuzz seed 201039, --swept)
+        seen = areal(snapped(shapely.union, reg, core, g))
+        return polygonal(snapped(shapely.difference, self.free, seen, g))
+
+    def _eroded_core(self, qa: np.ndarray, qb: np.ndarray) -> tuple | None:
+        """The part of A common to all A_q, q in [qa, qb] (its largest piece) and its
+        outline (clockwise), or None when it is empty (:meth:`_eroded_shadow`)."""
         aa = shapely.Polygon(self.ring0 + qa)
         ab = shapely.Polygon(self.ring0 + qb)
         core = shapely.intersection(aa, ab)
@@ -834,13 +968,23 @@ class Sweeper:
         parts = shapely.get_parts(core)
         core = parts[np.argmax(shapely.area(parts))]
         ring = np.asarray(shapely.orient_polygons(core, exterior_cw=True).exterior.coords)[:-1]
-        reg = weak_visibility(
-            self.env, ring, np.ones(len(ring), dtype=bool), self.eps_aim, self._anchors()
-        )
-        g = self.shadow_grid  # as in shadow(): the region's hole nearly coincides with core
-        # snap-rounding can raise "Ring edge missing" at scale 1e-3 (fuzz seed 201039, --swept)
-        seen = areal(snapped(shapely.union, reg, core, g))
-        return polygonal(snapped(shapely.difference, self.free, seen, g))
+        return core, ring
+
+    def _prefetch_eroded(self, pairs: list[tuple[np.ndarray, np.ndarray]]) -> None:
+        """The weak visibility regions that :meth:`_eroded_shadow` needs for the intervals
+        ``pairs`` ((qa, qb) each), in one batch (:meth:`_prefetch`); kept until taken."""
+        todo = []
+        for qa, qb in pairs:
+            got = self._eroded_core(qa, qb)
+            if got is not None:
+                todo.append(((tuple(qa.tolist()), tuple(qb.tolist())), got[1]))
+        if len(todo) < 2:
+            return
+        rings = [r for _, r in todo]
+        ones = [np.ones(len(r), dtype=bool) for r in rings]
+        regs = weak_visibility_many(self.env, rings, ones, self.eps_aim, self._anchors())
+        for (key, _), reg in zip(todo, regs, strict=True):
+            self._eroded_pre[key] = reg
 
     def _trace_many(self, edges: list, ta: float, tb: float, q0, dq) -> tuple[list, list]:
         """Areas swept by moving shadow edges found at sample ``ta`` while they live
@@ -1280,6 +1424,10 @@ def swept_shadows(
                 np.asarray(ring.coords)[:-1, :2], np.asarray(ring.coords)[1:, :2], strict=True
             )
         ]
+        # the samples at the vertices of the region's boundary in one batch (along() sets
+        # the same grazing mask)
+        sw._grazing = sw._anchors()
+        sw._prefetch([np.asarray(a, dtype=float) for a, _ in segs])
         for done, (a, b) in enumerate(segs):
             try:
                 got, st = sw.along(a, b)
@@ -1301,11 +1449,53 @@ def swept_shadows(
         else:
             samples.extend((np.array(k) - c, v[0]) for k, v in sw._frames.items())
             ts = np.arange(1, extra_samples + 1) / (extra_samples + 1)
+            sw._prefetch([a + t * (b - a) for a, b in segs for t in ts])  # one batch
             for a, b in segs:
                 for t in ts:
                     q = a + t * (b - a)
                     samples.append((q - c, sw.shadow(q)[0]))
-    return polygonal(union_all(pieces, grid_size=sw.grid)), stats
+    return _union_pieces(sw, pieces), stats
+
+
+def _union_pieces(sw: Sweeper, pieces: list[shapely.Geometry]) -> shapely.Geometry:
+    """The union of the pieces of a sweep (its sampled stationary shadows and traced
+    quads), snap-rounded on ``sw.grid``.
+
+    The sampled shadows are ``S_k = F - X_k`` (``F`` the free space, ``X_k`` the target
+    and its weak visibility region at sample k, kept by :meth:`Sweeper.shadow`), so their
+    union is ``F - (X_1 n ... n X_n)`` (De Morgan): the intersection of the small sets
+    ``X_k`` (near the region, balanced pairwise) and one difference with the free space
+    replace the union of n shadows that each span the whole map (nearly coincident
+    copies of the free space's boundary: GEOS's overlay spent most of its time there).
+    The traced quads are united with that.  Every overlay snap-rounds on ``sw.grid``, as
+    the one union it replaces did (:func:`swept_shadows`).  Parts of ``F - X_k`` that
+    :meth:`Sweeper.shadow` dropped as float slivers (area below
+    ``geometry._shapes.SLIVER`` times their squared perimeter) are part of this union.
+    Shadows without their ``X_k`` (none expected) fall back to the plain union."""
+    by_id = {id(v[0]): k for k, v in sw._frames.items()}
+    keys = list(dict.fromkeys(by_id[id(p)] for p in pieces if id(p) in by_id))
+    rest = [p for p in pieces if id(p) not in by_id]
+    if not keys or any(k not in sw._seen for k in keys):
+        return polygonal(union_all(pieces, grid_size=sw.grid))
+    g = sw.grid
+    pairs = sw.__dict__.get("_pairs", {})
+    xs = []
+    i = 0
+    while i < len(keys):  # consecutive samples: their intersection is often kept already
+        if i + 1 < len(keys) and (keys[i], keys[i + 1]) in pairs:
+            xs.append(pairs[(keys[i], keys[i + 1])])
+            i += 2
+        else:
+            xs.append(sw._seen[keys[i]])
+            i += 1
+    while len(xs) > 1:
+        pairs = zip(xs[0::2], xs[1::2], strict=False)  # an odd one out waits a round
+        nxt = [areal(snapped(shapely.intersection, a, b, g)) for a, b in pairs]
+        xs = nxt + xs[len(nxt) * 2 :]
+    shadows = areal(snapped(shapely.difference, sw.free, xs[0], g))
+    if not rest:
+        return polygonal(shadows)
+    return polygonal(union_all([shadows, *rest], grid_size=g))
 
 
 def snap_grid(scale: float) -> float:

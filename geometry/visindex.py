@@ -705,3 +705,127 @@ def window_ranges(
         his.append(hi[:m])
         owns.append(ow[:m])
     return np.concatenate(los), np.concatenate(his), np.concatenate(owns)
+
+
+@_njit
+def _first_hits_rings_kernel(
+    q, phi, ring_of, ring_seg, ring_len, seg, x0, y0, h, nx, ny, start, items, extra_base, tmin, out
+):  # pragma: no cover
+    """:func:`_first_hits_kernel` with the added segments chosen per ray: ray ``i`` tests
+    ``ring_seg[ring_of[i], :ring_len[ring_of[i]]]`` (numbered from ``extra_base``).  The
+    statements are those of the one-domain kernel, so each ray's answer is bit for bit
+    what that kernel gives for the domain extended by the ray's own ring."""
+    for i in range(phi.shape[0]):
+        qx, qy = q[i, 0], q[i, 1]
+        dx, dy = math.cos(phi[i]), math.sin(phi[i])
+        best_t = math.inf
+        best = -1
+        r = ring_of[i]
+        for k in range(ring_len[r]):
+            t = _hit(
+                qx, qy, dx, dy, ring_seg[r, k, 0], ring_seg[r, k, 1], ring_seg[r, k, 2],
+                ring_seg[r, k, 3], tmin,
+            )  # fmt: skip
+            if t < best_t:
+                best_t = t
+                best = extra_base + k
+        if not (x0 <= qx <= x0 + nx * h and y0 <= qy <= y0 + ny * h):
+            for j in range(seg.shape[0]):
+                t = _hit(qx, qy, dx, dy, seg[j, 0], seg[j, 1], seg[j, 2], seg[j, 3], tmin)
+                if t < best_t or (t == best_t and j < best):
+                    best_t = t
+                    best = j
+            out[i] = best
+            continue
+        ix = int(math.floor((qx - x0) / h))
+        iy = int(math.floor((qy - y0) / h))
+        ix = max(0, min(nx - 1, ix))
+        iy = max(0, min(ny - 1, iy))
+        if dx > 0.0:
+            step_x = 1
+            t_max_x = (x0 + (ix + 1) * h - qx) / dx
+            t_dx = h / dx
+        elif dx < 0.0:
+            step_x = -1
+            t_max_x = (x0 + ix * h - qx) / dx
+            t_dx = -h / dx
+        else:
+            step_x = 0
+            t_max_x = math.inf
+            t_dx = math.inf
+        if dy > 0.0:
+            step_y = 1
+            t_max_y = (y0 + (iy + 1) * h - qy) / dy
+            t_dy = h / dy
+        elif dy < 0.0:
+            step_y = -1
+            t_max_y = (y0 + iy * h - qy) / dy
+            t_dy = -h / dy
+        else:
+            step_y = 0
+            t_max_y = math.inf
+            t_dy = math.inf
+        while True:
+            c = iy * nx + ix
+            for p in range(start[c], start[c + 1]):
+                j = items[p]
+                t = _hit(qx, qy, dx, dy, seg[j, 0], seg[j, 1], seg[j, 2], seg[j, 3], tmin)
+                if t < best_t or (t == best_t and j < best):
+                    best_t = t
+                    best = j
+            if t_max_x < t_max_y:
+                if best_t <= t_max_x:
+                    break
+                ix += step_x
+                if ix < 0 or ix >= nx:
+                    break
+                t_max_x += t_dx
+            else:
+                if best_t <= t_max_y:
+                    break
+                iy += step_y
+                if iy < 0 or iy >= ny:
+                    break
+                t_max_y += t_dy
+        out[i] = best
+
+
+def first_hits_rings(
+    base: Domain,
+    ring_seg: np.ndarray,
+    ring_len: np.ndarray,
+    ring_of: np.ndarray,
+    q: np.ndarray,
+    phi: np.ndarray,
+) -> np.ndarray:
+    """:func:`first_hits` for rays in several domains at once: ray ``i`` is cast in
+    ``base`` extended (:meth:`Domain.with_ring`) by ring ``ring_of[i]``, whose segments are
+    ``ring_seg[r, :ring_len[r]]`` ((R, K, 4), padded).  ``base`` must be a domain with its
+    own grid (not itself extended).  Segment ``k`` of a ring is numbered ``len(base.seg) +
+    k``, as in the extended domain; -1 where a ray escapes.  Bit for bit the answers of
+    :func:`first_hits` on each extended domain."""
+    grid, n_base = grid_for(base)
+    if n_base != len(base.seg):
+        raise ValueError("first_hits_rings: base must not be an extended domain")
+    phi = np.ascontiguousarray(phi, dtype=np.float64)
+    q = np.ascontiguousarray(np.broadcast_to(q, (len(phi), 2)), dtype=np.float64)
+    out = np.empty(len(phi), dtype=np.int64)
+    _first_hits_rings_kernel(
+        q,
+        phi,
+        np.ascontiguousarray(ring_of, dtype=np.int64),
+        np.ascontiguousarray(ring_seg, dtype=np.float64),
+        np.ascontiguousarray(ring_len, dtype=np.int64),
+        grid.seg,
+        grid.x0,
+        grid.y0,
+        grid.h,
+        grid.nx,
+        grid.ny,
+        grid.start,
+        grid.items,
+        n_base,
+        1e-11 * base.scale,
+        out,
+    )
+    return out

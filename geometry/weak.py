@@ -11,8 +11,9 @@ from __future__ import annotations
 import numpy as np
 import shapely
 
+from . import visindex as _visindex
 from ._shapes import cross, union_all
-from ._vis import TAU, Domain, Gaps, clean_polygon, gaps_many
+from ._vis import TAU, Domain, Gaps, RingSet, clean_polygon, gaps_many, gaps_many_rings
 from .scene import NEAR_REL
 
 __all__ = ["CONTACT_REL", "ENV", "UNWANTED", "WANTED", "snap_to_boundary", "weak_visibility"]
@@ -453,3 +454,295 @@ def _fans(g: Gaps, mask: np.ndarray, dom: Domain, eps_aim: float) -> list[shapel
             keep[3::2] = ~same
             out.append(clean_polygon(pts[keep], 1e-10 * dom.scale))
     return out
+
+
+def weak_visibility_many(
+    env: Domain,
+    rings: list[np.ndarray],
+    wanted: list[np.ndarray],
+    eps_aim: float = 0.0,
+    grazing: np.ndarray | None = None,
+) -> list[shapely.Geometry]:
+    """:func:`weak_visibility` of several target outlines in one free space: the same
+    answers, bit for bit, with the ray casting of all targets done together.
+
+    Each target is a hole of its own domain (it occludes only itself), so the viewpoints
+    of all targets are cast at once by :func:`geometry._vis.gaps_many_rings` (one call
+    per kind of anchor instead of one per target); the rest is :func:`weak_visibility`'s
+    code, target by target.  ``rings[i]``, ``wanted[i]``: as ``ring`` and ``wanted`` of
+    :func:`weak_visibility`.  Without the compiled index
+    (:func:`geometry.visindex.available`), or for a domain that is itself extended, the
+    targets are done one by one."""
+    if not (_visindex.available() and getattr(env, "_parent", None) is None) or not rings:
+        return [
+            weak_visibility(env, r, w, eps_aim, grazing) for r, w in zip(rings, wanted, strict=True)
+        ]
+    nv = len(env.vert)
+    snapped = [snap_to_boundary(env, r, w) for r, w in zip(rings, wanted, strict=True)]
+    rings = [r for r, _ in snapped]
+    wanted = [w for _, w in snapped]
+    doms = [
+        env.with_ring(r, UNWANTED, np.where(w, WANTED, UNWANTED))
+        for r, w in zip(rings, wanted, strict=True)
+    ]
+    rs = RingSet.of(env, doms)
+    fans: list[list] = [[] for _ in rings]
+    # 1. anchors on the targets (weak_visibility, step 1)
+    q1, e1, own1, meta1 = [], [], [], []
+    for r, (ring, wnt, dom) in enumerate(zip(rings, wanted, doms, strict=True)):
+        edge = np.roll(ring, -1, axis=0) - ring
+        inc = np.stack([wnt, np.roll(wnt, 1)], axis=1)
+        anchors = np.flatnonzero(inc.any(axis=1))
+        if not len(anchors):
+            meta1.append(None)
+            continue
+        e_out, e_in = edge[anchors], np.roll(edge, 1, axis=0)[anchors]
+        dirs = np.stack([e_out, e_in], axis=1)
+        ang = np.arctan2(dirs[..., 1], dirs[..., 0])
+        extra = np.concatenate([ang + np.pi, ang], axis=1)
+        arcs = _pinch_arcs(dom, nv + anchors)
+        if arcs is not None:
+            extra = np.concatenate([extra, arcs[..., 0], arcs[..., 0] + arcs[..., 1]], axis=1)
+        q1.append(ring[anchors])
+        e1.append(extra)
+        own1.append(np.full(len(anchors), r))
+        meta1.append((edge, anchors, arcs))
+    g1 = off1 = None
+    if q1:
+        g1, off1 = gaps_many_rings(rs, np.concatenate(own1), np.concatenate(q1), extra=_padded(e1))
+    row = 0
+    qs1 = np.concatenate(q1) if q1 else np.zeros((0, 2))
+    flat = eps_aim == 0  # the fans of all viewpoints at once (_fans_flat)
+    masks = []
+    for r, (wnt, dom) in enumerate(zip(wanted, doms, strict=True)):
+        if meta1[r] is None:
+            continue
+        edge, anchors, arcs = meta1[r]
+        for k, i in enumerate(anchors):
+            gi = _slice(g1, off1[row], off1[row + 1], qs1[row])
+            row += 1
+            mid = 0.5 * (gi.lo + gi.hi)
+            d = np.stack([np.cos(mid), np.sin(mid)], axis=1)
+            front = np.zeros(len(mid), dtype=bool)
+            for e, along, use in (
+                (edge[i], edge[i], wnt[i]),
+                (edge[i - 1], -edge[i - 1], wnt[i - 1]),
+            ):
+                if use:
+                    f = e[0] * d[:, 1] - e[1] * d[:, 0] > 0
+                    if arcs is not None:
+                        f &= ~_between(arcs[k], mid, float(np.arctan2(along[1], along[0])))
+                    front |= f
+            if flat:
+                masks.append(front & (gi.seg >= 0))
+            else:
+                fans[r] += _fans(gi, front & (gi.seg >= 0), dom, eps_aim)
+    if flat and masks:
+        got, view = _fans_flat(g1, off1, qs1, np.concatenate(masks), 1e-10 * env.scale)
+        own = np.concatenate(own1)[view]
+        for f, r in zip(got, own.tolist(), strict=True):
+            fans[r].append(f)
+    n_direct = [len(f) for f in fans]
+    # 2. grazing anchors (weak_visibility, step 2): the directions that see a wanted piece
+    q2, s2, e2, own2, meta2 = [], [], [], [], []
+    for r, (ring, dom) in enumerate(zip(rings, doms, strict=True)):
+        v_idx = np.flatnonzero(dom.reflex)
+        if grazing is not None:
+            v_idx = v_idx[(v_idx >= nv) | grazing[np.minimum(v_idx, nv - 1)]]
+        v = dom.vert[v_idx]
+        if not len(v):
+            meta2.append(None)
+            continue
+        rel = np.arctan2(ring[None, :, 1] - v[:, None, 1], ring[None, :, 0] - v[:, None, 0])
+        centre = ring.mean(axis=0)
+        base = np.arctan2(centre[1] - v[:, 1], centre[0] - v[:, 0])
+        rel = (rel - base[:, None] + np.pi) % TAU - np.pi
+        on_target = np.abs(ring[None, :, :] - v[:, None, :]).max(axis=2) <= 1e-12 * dom.scale
+        lo = np.where(on_target, np.inf, rel).min(axis=1)
+        hi = np.where(on_target, -np.inf, rel).max(axis=1)
+        ok = hi - lo > 1e-12
+        v, sectors = v[ok], np.stack([base[ok] + lo[ok], hi[ok] - lo[ok]], axis=1)
+        arcs = _pinch_arcs(dom, v_idx[ok])
+        extra = None
+        if arcs is not None:
+            a0, a1 = arcs[..., 0], arcs[..., 0] + arcs[..., 1]
+            extra = np.concatenate([a0, a1, a0 - np.pi, a1 - np.pi], axis=1)
+        q2.append(v)
+        s2.append(sectors)
+        e2.append(extra if extra is not None else np.zeros((len(v), 0)))
+        own2.append(np.full(len(v), r))
+        meta2.append((v, arcs))
+    back_q, back_sec, back_own = [], [], []
+    if q2:
+        g, off = gaps_many_rings(
+            rs, np.concatenate(own2), np.concatenate(q2), sectors=np.concatenate(s2),
+            extra=_padded(e2),
+        )  # fmt: skip
+        at = np.cumsum([0] + [len(x) for x in q2])
+        sees = np.zeros(len(g.lo), dtype=bool)
+        for b, r in enumerate(np.concatenate(own2)[at[:-1]]):
+            v, arcs = meta2[r]
+            lo_v, hi_v = at[b], at[b + 1]
+            if off[hi_v] == off[lo_v]:
+                continue
+            g0, g1_ = off[lo_v], off[hi_v]
+            seg = g.seg[g0:g1_]
+            s_ = (seg >= 0) & (doms[r].seg_tag[np.maximum(seg, 0)] == WANTED)
+            if arcs is not None:
+                owner = np.searchsorted(off[lo_v : hi_v + 1] - g0, np.arange(g1_ - g0), "right") - 1
+                s_ &= _grazes(arcs[owner], 0.5 * (g.lo[g0:g1_] + g.hi[g0:g1_]))
+            sees[g0:g1_] = s_
+        gi, bounds = _runs_flat(g, off, sees)
+        if len(bounds) > 1:
+            first, last = gi[bounds[:-1]], gi[bounds[1:] - 1]
+            view = np.searchsorted(off, first, side="right") - 1
+            width = (g.hi[last] - g.lo[first]) % TAU
+            width = np.where(width == 0.0, TAU, width)  # _width
+            vs, owns = np.concatenate(q2), np.concatenate(own2)
+            back_q = list(vs[view])
+            back_sec = list(zip((g.lo[first] + np.pi).tolist(), width.tolist(), strict=True))
+            back_own = owns[view].tolist()
+    # ... then the placements on the opposite side of v
+    if back_q:
+        g, off = gaps_many_rings(
+            rs, np.asarray(back_own), np.asarray(back_q), sectors=np.asarray(back_sec)
+        )
+        if flat:
+            got, view = _fans_flat(g, off, np.asarray(back_q), g.seg >= 0, 1e-10 * env.scale)
+            for f, r in zip(got, np.asarray(back_own)[view].tolist(), strict=True):
+                fans[r].append(f)
+        else:
+            for b, r in enumerate(back_own):
+                gb = _slice(g, off[b], off[b + 1], np.asarray(back_q[b]))
+                fans[r] += _fans(gb, gb.seg >= 0, doms[r], eps_aim)
+    out = []
+    for r, dom in enumerate(doms):
+        arr = np.asarray(fans[r], dtype=object)
+        if not len(arr):
+            out.append(shapely.Polygon())
+            continue
+        thick = shapely.area(arr) > CONTACT_REL * dom.scale * shapely.length(arr)
+        nd = int(thick[: n_direct[r]].sum())
+        kept = list(arr[thick])
+        out.append(_union(kept, n_first=nd) if kept else shapely.Polygon())
+    return out
+
+
+def _padded(cols: list[np.ndarray]) -> np.ndarray | None:
+    """Row blocks of different widths stacked, NaN-padded (None when all are empty)."""
+    k = max(c.shape[1] for c in cols)
+    if k == 0:
+        return None
+    out = np.full((sum(len(c) for c in cols), k), np.nan)
+    at = 0
+    for c in cols:
+        out[at : at + len(c), : c.shape[1]] = c
+        at += len(c)
+    return out
+
+
+def _slice(g: Gaps, a: int, b: int, q: np.ndarray) -> Gaps:
+    """Gaps ``a:b`` of a flat result, with ``q`` (the viewpoint, or one row per gap as in a
+    flat result)."""
+    return Gaps(q=q, lo=g.lo[a:b], hi=g.hi[a:b], seg=g.seg[a:b], p0=g.p0[a:b], p1=g.p1[a:b])
+
+
+def _runs_flat(g: Gaps, off: np.ndarray, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_runs` of every viewpoint of a flat result at once (viewpoint ``v`` owns gaps
+    ``off[v]:off[v + 1]``): the gap indices of all runs, run after run in the order
+    :func:`_runs` lists them viewpoint by viewpoint, and the (R + 1,) offsets of the
+    runs in that array."""
+    idx = np.flatnonzero(mask)
+    if len(idx) == 0:
+        return idx, np.zeros(1, dtype=np.int64)
+    n_v = len(off) - 1
+    owner = np.repeat(np.arange(n_v), np.diff(off))
+    o = owner[idx]
+    new = np.ones(len(idx), dtype=bool)
+    new[1:] = (o[1:] != o[:-1]) | ~(np.abs(g.lo[idx[1:]] - g.hi[idx[:-1]]) <= 1e-12)
+    run = np.cumsum(new) - 1
+    n_runs = np.bincount(o, weights=new, minlength=n_v).astype(np.int64)
+    # a viewpoint whose gaps close the circle, masked at both ends, with several runs:
+    # its last run continues into its first (listed first, last run's gaps before)
+    has = np.diff(off) > 0
+    first = np.where(has, off[:-1], 0)
+    last = np.where(has, off[1:] - 1, 0)
+    closed = has & (np.abs(g.hi[last] - g.lo[first] - TAU) <= 1e-12)
+    merge = closed & mask[first] & mask[last] & (n_runs > 1)
+    starts = np.flatnonzero(new)
+    rv = o[starts]  # viewpoint of each run
+    run_first = np.full(n_v, -1, dtype=np.int64)
+    run_last = np.full(n_v, -1, dtype=np.int64)
+    u, at = np.unique(rv, return_index=True)  # runs are in viewpoint order
+    run_first[u] = at
+    run_last[u] = np.concatenate([at[1:], [len(rv)]]) - 1
+    in_last = merge[o] & (run == run_last[o])
+    label = np.where(in_last, run_first[o], run)
+    order = np.lexsort((np.arange(len(idx)), ~in_last, o))
+    label = label[order]
+    bounds = np.flatnonzero(np.concatenate([[True], label[1:] != label[:-1], [True]]))
+    return idx[order], bounds
+
+
+def _fans_flat(g: Gaps, off: np.ndarray, q: np.ndarray, mask: np.ndarray, tol: float) -> tuple:
+    """:func:`_fans` with ``eps_aim == 0`` for every viewpoint of a flat result at once
+    (viewpoint ``v``, at ``q[v]``, owns gaps ``off[v]:off[v + 1]``): the fans, in the
+    order :func:`_fans` gives them viewpoint by viewpoint, and the viewpoint of each.
+    The same points are kept and :func:`geometry._vis.clean_polygon`'s rule is applied
+    to each ring (``tol``: its tolerance), so every polygon is the one :func:`_fans`
+    builds."""
+    gi, bounds = _runs_flat(g, off, mask)
+    n_runs = len(bounds) - 1
+    if n_runs == 0:
+        return [], np.zeros(0, dtype=np.int64)
+    owner = np.repeat(np.arange(len(off) - 1), np.diff(off))
+    ln = np.diff(bounds)
+    rid = np.repeat(np.arange(n_runs), ln)
+    m = np.arange(len(gi)) - bounds[rid]
+    seg = g.seg[gi]
+    same_next = np.zeros(len(gi), dtype=bool)
+    same_next[:-1] = seg[1:] == seg[:-1]
+    same_next &= m < ln[rid] - 1
+    same_prev = np.zeros(len(gi), dtype=bool)
+    same_prev[1:] = seg[1:] == seg[:-1]
+    same_prev &= m > 0
+    # per run: the viewpoint, then p0 and p1 of each gap
+    base = np.arange(n_runs) + 2 * bounds[:-1]
+    total = n_runs + 2 * len(gi)
+    pts = np.empty((total, 2))
+    keep = np.empty(total, dtype=bool)
+    ring = np.empty(total, dtype=np.int64)
+    view = owner[gi[bounds[:-1]]]
+    pts[base] = q[view]
+    keep[base] = True
+    ring[base] = np.arange(n_runs)
+    at0 = base[rid] + 1 + 2 * m
+    pts[at0], keep[at0], ring[at0] = g.p0[gi], ~same_prev, rid
+    pts[at0 + 1], keep[at0 + 1], ring[at0 + 1] = g.p1[gi], ~same_next, rid
+    pts, ring = pts[keep], ring[keep]
+    # clean_polygon: drop the points within tol of their successor (around the ring)
+    cnt = np.bincount(ring, minlength=n_runs)
+    start = np.concatenate([[0], np.cumsum(cnt)])
+    nxt = np.arange(1, len(pts) + 1)
+    ends = start[1:] - 1
+    nxt[ends[cnt > 0]] = start[:-1][cnt > 0]
+    step = np.abs(pts[nxt] - pts).max(axis=1)
+    ok = step > tol
+    pts, ring = pts[ok], ring[ok]
+    cnt = np.bincount(ring, minlength=n_runs)
+    out = np.empty(n_runs, dtype=object)
+    small = cnt < 3
+    out[small] = [shapely.Polygon() for _ in range(int(small.sum()))]
+    big = np.flatnonzero(~small)
+    if len(big):
+        sel = ~small[ring]
+        renum = np.cumsum(~small) - 1
+        rings = shapely.linearrings(pts[sel], indices=renum[ring[sel]])
+        polys = shapely.polygons(rings)
+        bad = ~shapely.is_valid(polys)
+        for b in np.flatnonzero(bad):  # clean_polygon's repair
+            parts = shapely.get_parts(shapely.make_valid(polys[b]))
+            parts = parts[np.isin(shapely.get_type_id(parts), (3, 6))]
+            polys[b] = shapely.union_all(parts) if len(parts) else shapely.Polygon()
+        out[big] = polys
+    return list(out), view
