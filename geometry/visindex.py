@@ -308,19 +308,56 @@ def grid_for(dom: Domain) -> tuple[SegmentGrid, int]:
 def first_hits(dom: Domain, q: np.ndarray, phi: np.ndarray) -> np.ndarray:
     """Index of the first segment of ``dom`` hit by rays from ``q`` ((2,) or (k, 2)) at
     angles ``phi`` (k,), or -1 where a ray escapes -- the same answer as the brute force
-    :func:`geometry._vis._first_hits` (which raises on escapes)."""
+    :func:`geometry._vis._first_hits` (which raises on escapes).  The batch of one ring of
+    :func:`first_hits_rings`: the segments ``dom`` adds to its grid's domain."""
     grid, n_base = grid_for(dom)
+    ring_seg = dom.seg[None, n_base:]
+    n = len(np.atleast_1d(phi))
+    return _cast(
+        grid, n_base, dom.scale, ring_seg, [ring_seg.shape[1]], np.zeros(n, np.int64), q, phi
+    )
+
+
+def first_hits_rings(
+    base: Domain,
+    ring_seg: np.ndarray,
+    ring_len: np.ndarray,
+    ring_of: np.ndarray,
+    q: np.ndarray,
+    phi: np.ndarray,
+) -> np.ndarray:
+    """:func:`first_hits` for rays in several domains at once: ray ``i`` is cast in
+    ``base`` extended (:meth:`Domain.with_ring`) by ring ``ring_of[i]``, whose segments are
+    ``ring_seg[r, :ring_len[r]]`` ((R, K, 4), padded).  ``base`` must be a domain with its
+    own grid (not itself extended).  Segment ``k`` of a ring is numbered ``len(base.seg) +
+    k``, as in the extended domain; -1 where a ray escapes.  Bit for bit the answers of
+    :func:`first_hits` on each extended domain (both run :func:`_first_hits_kernel`)."""
+    grid, n_base = grid_for(base)
+    if n_base != len(base.seg):
+        raise ValueError("first_hits_rings: base must not be an extended domain")
+    return _cast(grid, n_base, base.scale, ring_seg, ring_len, ring_of, q, phi)
+
+
+def _cast(
+    grid: SegmentGrid,
+    n_base: int,
+    scale: float,
+    ring_seg: np.ndarray,
+    ring_len: np.ndarray | list[int],
+    ring_of: np.ndarray,
+    q: np.ndarray,
+    phi: np.ndarray,
+) -> np.ndarray:
+    """Run :func:`_first_hits_kernel` (``tmin = 1e-11 scale``) on contiguous copies."""
     phi = np.ascontiguousarray(phi, dtype=np.float64)
     q = np.ascontiguousarray(np.broadcast_to(q, (len(phi), 2)), dtype=np.float64)
-    # the segments added to the grid's domain (rings of with_ring): one ring, every ray's
-    ring_seg = np.ascontiguousarray(dom.seg[None, n_base:], dtype=np.float64)
     out = np.empty(len(phi), dtype=np.int64)
     _first_hits_kernel(
         q,
         phi,
-        np.zeros(len(phi), dtype=np.int64),
-        ring_seg,
-        np.array([ring_seg.shape[1]], dtype=np.int64),
+        np.ascontiguousarray(ring_of, dtype=np.int64),
+        np.ascontiguousarray(ring_seg, dtype=np.float64),
+        np.ascontiguousarray(ring_len, dtype=np.int64),
         grid.seg,
         grid.x0,
         grid.y0,
@@ -330,7 +367,7 @@ def first_hits(dom: Domain, q: np.ndarray, phi: np.ndarray) -> np.ndarray:
         grid.start,
         grid.items,
         n_base,
-        1e-11 * dom.scale,
+        1e-11 * scale,
         out,
     )
     return out
@@ -736,44 +773,3 @@ def window_ranges(
         his.append(hi[:m])
         owns.append(ow[:m])
     return np.concatenate(los), np.concatenate(his), np.concatenate(owns)
-
-
-def first_hits_rings(
-    base: Domain,
-    ring_seg: np.ndarray,
-    ring_len: np.ndarray,
-    ring_of: np.ndarray,
-    q: np.ndarray,
-    phi: np.ndarray,
-) -> np.ndarray:
-    """:func:`first_hits` for rays in several domains at once: ray ``i`` is cast in
-    ``base`` extended (:meth:`Domain.with_ring`) by ring ``ring_of[i]``, whose segments are
-    ``ring_seg[r, :ring_len[r]]`` ((R, K, 4), padded).  ``base`` must be a domain with its
-    own grid (not itself extended).  Segment ``k`` of a ring is numbered ``len(base.seg) +
-    k``, as in the extended domain; -1 where a ray escapes.  Bit for bit the answers of
-    :func:`first_hits` on each extended domain."""
-    grid, n_base = grid_for(base)
-    if n_base != len(base.seg):
-        raise ValueError("first_hits_rings: base must not be an extended domain")
-    phi = np.ascontiguousarray(phi, dtype=np.float64)
-    q = np.ascontiguousarray(np.broadcast_to(q, (len(phi), 2)), dtype=np.float64)
-    out = np.empty(len(phi), dtype=np.int64)
-    _first_hits_kernel(
-        q,
-        phi,
-        np.ascontiguousarray(ring_of, dtype=np.int64),
-        np.ascontiguousarray(ring_seg, dtype=np.float64),
-        np.ascontiguousarray(ring_len, dtype=np.int64),
-        grid.seg,
-        grid.x0,
-        grid.y0,
-        grid.h,
-        grid.nx,
-        grid.ny,
-        grid.start,
-        grid.items,
-        n_base,
-        1e-11 * base.scale,
-        out,
-    )
-    return out
