@@ -139,6 +139,51 @@ def _blocking(dom: Domain, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.nd
     return w1, w2, along
 
 
+def _sector_bounds(sectors: np.ndarray | None, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """``start, width`` (n,) radians of the sectors of :func:`gaps_many` (a NaN row, or
+    no ``sectors``, is the full circle ``(0, 2 pi)``; widths capped at 2 pi)."""
+    start = np.zeros(n)
+    width = np.full(n, TAU)
+    if sectors is not None:
+        has = ~np.isnan(sectors[:, 0])
+        start[has] = sectors[has, 0]
+        width[has] = np.minimum(sectors[has, 1], TAU)
+    return start, width
+
+
+def _blocking_crit(w1: np.ndarray, w2: np.ndarray, along: np.ndarray) -> np.ndarray:
+    """(n, 6) critical directions (radians, NaN where none) of the local obstruction of
+    :func:`_blocking`: the sides of both wedges and both directions along the segment."""
+    return np.stack(
+        [
+            w1[:, 0],
+            w1[:, 0] + w1[:, 1],
+            w2[:, 0],
+            w2[:, 0] + w2[:, 1],
+            _libm.atan2(along[:, 1], along[:, 0]),
+            _libm.atan2(-along[:, 1], -along[:, 0]),
+        ],
+        axis=1,
+    )
+
+
+def _unblocked(
+    mid: np.ndarray, owner: np.ndarray, w1: np.ndarray, w2: np.ndarray, along: np.ndarray
+) -> np.ndarray:
+    """True for the gaps whose middle direction ``mid`` (radians) leaves viewpoint
+    ``owner`` into free space: inside both wedges of :func:`_blocking` (where present)
+    and not to the right of the segment the viewpoint lies on."""
+    open_ = np.ones(len(mid), dtype=bool)
+    for w in (w1, w2):
+        w0 = w[owner, 0]
+        with np.errstate(invalid="ignore"):
+            open_ &= np.isnan(w0) | (((mid - w0) % TAU) < w[owner, 1])
+    ax, ay = along[owner, 0], along[owner, 1]
+    with np.errstate(invalid="ignore"):
+        open_ &= np.isnan(ax) | (ax * _libm.sin(mid) - ay * _libm.cos(mid) >= 0)
+    return open_
+
+
 def gaps_many(
     dom: Domain,
     q: np.ndarray,
@@ -164,44 +209,20 @@ def gaps_many(
     q = np.asarray(q, dtype=float).reshape(-1, 2)
     n = len(q)
     tol = 1e-12 * dom.scale
-    start = np.zeros(n)
-    width = np.full(n, TAU)
-    if sectors is not None:
-        has = ~np.isnan(sectors[:, 0])
-        start[has] = sectors[has, 0]
-        width[has] = np.minimum(sectors[has, 1], TAU)
+    start, width = _sector_bounds(sectors, n)
     if interior:
         w1 = w2 = along = np.full((n, 2), np.nan)
     else:
         w1, w2, along = _blocking(dom, q)
     cols = [] if extra is None else [extra]
-    cols.append(
-        np.stack(
-            [
-                w1[:, 0],
-                w1[:, 0] + w1[:, 1],
-                w2[:, 0],
-                w2[:, 0] + w2[:, 1],
-                _libm.atan2(along[:, 1], along[:, 0]),
-                _libm.atan2(-along[:, 1], -along[:, 0]),
-            ],
-            axis=1,
-        )
-    )
+    cols.append(_blocking_crit(w1, w2, along))
     crit = np.concatenate(cols, axis=1)
     if _visindex.available():
         owner, lo, hi = _visindex.sorted_gaps(q, start, width, dom.vert, crit, tol, interior, dom)
     else:
         owner, lo, hi = _sorted_gaps(q, start, width, dom.vert, crit, tol, interior)
     mid = 0.5 * (lo + hi)
-    open_ = np.ones(len(mid), dtype=bool)
-    for w in (w1, w2):
-        w0 = w[owner, 0]
-        with np.errstate(invalid="ignore"):
-            open_ &= np.isnan(w0) | (((mid - w0) % TAU) < w[owner, 1])
-    ax, ay = along[owner, 0], along[owner, 1]
-    with np.errstate(invalid="ignore"):
-        open_ &= np.isnan(ax) | (ax * _libm.sin(mid) - ay * _libm.cos(mid) >= 0)
+    open_ = _unblocked(mid, owner, w1, w2, along)
     qo = q[owner]
     seg = np.full(len(mid), -1, dtype=np.int64)
     idx = np.flatnonzero(open_)
@@ -421,10 +442,6 @@ def _blocking_rings(rs: RingSet, dom_of: np.ndarray, q: np.ndarray) -> tuple:
     base = rs.base
     nb = len(base.seg)
     tol = 1e-12 * base.scale
-    n = len(q)
-    w1 = np.full((n, 2), np.nan)
-    w2 = np.full((n, 2), np.nan)
-    along = np.full((n, 2), np.nan)
     rows, cols = _visindex.near_pairs(base, q, 2.0 * tol)
     # the rings' segments, by brute force (as near_pairs does for an extended domain)
     ex = rs.seg[dom_of]  # (n, K, 4)
@@ -439,31 +456,18 @@ def _blocking_rings(rs: RingSet, dom_of: np.ndarray, q: np.ndarray) -> tuple:
     cols = np.concatenate([cols, c2 + nb])
     order = np.lexsort((cols, rows))
     rows, cols = rows[order], cols[order]
-    if len(rows) == 0:
-        return w1, w2, along
     ring = cols >= nb
     k = np.where(ring, cols - nb, 0)
     own = dom_of[rows]
     vert = np.where(ring[:, None], rs.vert[own, k], base.vert[np.where(ring, 0, cols)])
     segs = np.where(ring[:, None], rs.seg[own, k], base.seg[np.where(ring, 0, cols)])
-    vnear = np.abs(vert - q[rows]).max(axis=1) <= tol
-    r, c = rows[vnear], cols[vnear]
-    if len(r):
+
+    def wedge_of(m: np.ndarray) -> np.ndarray:
+        rv = ring[m]
         env_wedge = _base_wedge(base)
-        rv, kv = ring[vnear], k[vnear]
-        wedge = np.where(rv[:, None], rs.wedge[own[vnear], kv], env_wedge[np.where(rv, 0, c)])
-        first = np.concatenate([[True], r[1:] != r[:-1]])
-        w1[r[first]] = wedge[first]
-        second = ~first & np.concatenate([[False], first[:-1]])
-        w2[r[second]] = wedge[second]
-    e = segs[:, 2:] - segs[:, :2]
-    L = np.hypot(e[:, 0], e[:, 1])
-    a = q[rows] - segs[:, :2]
-    dist = np.abs(e[:, 0] * a[:, 1] - e[:, 1] * a[:, 0]) / np.maximum(L, 1e-300)
-    t = (a[:, 0] * e[:, 0] + a[:, 1] * e[:, 1]) / np.maximum(L * L, 1e-300)
-    on = (dist <= tol) & (t * L > tol) & ((1 - t) * L > tol)
-    along[rows[on]] = e[on]
-    return w1, w2, along
+        return np.where(rv[:, None], rs.wedge[own[m], k[m]], env_wedge[np.where(rv, 0, cols[m])])
+
+    return _visindex.blocking_from_pairs(q, rows, vert, segs, wedge_of, tol)
 
 
 def _base_wedge(base: Domain) -> np.ndarray:
@@ -497,27 +501,10 @@ def gaps_many_rings(
     dom_of = np.asarray(dom_of, dtype=np.int64)
     n = len(q)
     tol = 1e-12 * base.scale
-    start = np.zeros(n)
-    width = np.full(n, TAU)
-    if sectors is not None:
-        has = ~np.isnan(sectors[:, 0])
-        start[has] = sectors[has, 0]
-        width[has] = np.minimum(sectors[has, 1], TAU)
+    start, width = _sector_bounds(sectors, n)
     w1, w2, along = _blocking_rings(rs, dom_of, q)
     cols = [] if extra is None else [extra]
-    cols.append(
-        np.stack(
-            [
-                w1[:, 0],
-                w1[:, 0] + w1[:, 1],
-                w2[:, 0],
-                w2[:, 0] + w2[:, 1],
-                _libm.atan2(along[:, 1], along[:, 0]),
-                _libm.atan2(-along[:, 1], -along[:, 0]),
-            ],
-            axis=1,
-        )
-    )
+    cols.append(_blocking_crit(w1, w2, along))
     # the ring's vertices: directions as the kernel computes them for a domain's vertex
     rv = rs.vert[dom_of]  # (n, K, 2)
     dx = rv[..., 0] - q[:, None, 0]
@@ -529,14 +516,7 @@ def gaps_many_rings(
     crit = np.concatenate(cols, axis=1)
     owner, lo, hi = _visindex.sorted_gaps(q, start, width, base.vert, crit, tol, False, base)
     mid = 0.5 * (lo + hi)
-    open_ = np.ones(len(mid), dtype=bool)
-    for w in (w1, w2):
-        w0 = w[owner, 0]
-        with np.errstate(invalid="ignore"):
-            open_ &= np.isnan(w0) | (((mid - w0) % TAU) < w[owner, 1])
-    ax, ay = along[owner, 0], along[owner, 1]
-    with np.errstate(invalid="ignore"):
-        open_ &= np.isnan(ax) | (ax * _libm.sin(mid) - ay * _libm.cos(mid) >= 0)
+    open_ = _unblocked(mid, owner, w1, w2, along)
     qo = q[owner]
     do = dom_of[owner]
     seg = np.full(len(mid), -1, dtype=np.int64)

@@ -30,6 +30,7 @@ is built once (:func:`geometry._common.scene_domain` caches the scene's domain).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -182,15 +183,24 @@ def _hit(qx, qy, dx, dy, sx0, sy0, sx1, sy1, tmin):  # pragma: no cover
 
 @_njit
 def _first_hits_kernel(
-    q, phi, seg, x0, y0, h, nx, ny, start, items, extra, extra_base, tmin, out
+    q, phi, ring_of, ring_seg, ring_len, seg, x0, y0, h, nx, ny, start, items, extra_base, tmin, out
 ):  # pragma: no cover
+    """First segment hit by each ray ``q[i] + t (cos phi[i], sin phi[i])``, ``t > tmin``:
+    the grid's segments by a walk through the cells, and the added segments of ray
+    ``i``'s own ring, ``ring_seg[ring_of[i], :ring_len[ring_of[i]]]`` (numbered from
+    ``extra_base``), by brute force; -1 where the ray escapes.  One domain is the batch
+    of one ring (:func:`first_hits`); several rings are :func:`first_hits_rings`."""
     for i in range(phi.shape[0]):
         qx, qy = q[i, 0], q[i, 1]
         dx, dy = math.cos(phi[i]), math.sin(phi[i])
         best_t = math.inf
         best = -1
-        for k in range(extra.shape[0]):
-            t = _hit(qx, qy, dx, dy, extra[k, 0], extra[k, 1], extra[k, 2], extra[k, 3], tmin)
+        r = ring_of[i]
+        for k in range(ring_len[r]):
+            t = _hit(
+                qx, qy, dx, dy, ring_seg[r, k, 0], ring_seg[r, k, 1], ring_seg[r, k, 2],
+                ring_seg[r, k, 3], tmin,
+            )  # fmt: skip
             if t < best_t:
                 best_t = t
                 best = extra_base + k
@@ -298,15 +308,56 @@ def grid_for(dom: Domain) -> tuple[SegmentGrid, int]:
 def first_hits(dom: Domain, q: np.ndarray, phi: np.ndarray) -> np.ndarray:
     """Index of the first segment of ``dom`` hit by rays from ``q`` ((2,) or (k, 2)) at
     angles ``phi`` (k,), or -1 where a ray escapes -- the same answer as the brute force
-    :func:`geometry._vis._first_hits` (which raises on escapes)."""
+    :func:`geometry._vis._first_hits` (which raises on escapes).  The batch of one ring of
+    :func:`first_hits_rings`: the segments ``dom`` adds to its grid's domain."""
     grid, n_base = grid_for(dom)
+    ring_seg = dom.seg[None, n_base:]
+    n = len(np.atleast_1d(phi))
+    return _cast(
+        grid, n_base, dom.scale, ring_seg, [ring_seg.shape[1]], np.zeros(n, np.int64), q, phi
+    )
+
+
+def first_hits_rings(
+    base: Domain,
+    ring_seg: np.ndarray,
+    ring_len: np.ndarray,
+    ring_of: np.ndarray,
+    q: np.ndarray,
+    phi: np.ndarray,
+) -> np.ndarray:
+    """:func:`first_hits` for rays in several domains at once: ray ``i`` is cast in
+    ``base`` extended (:meth:`Domain.with_ring`) by ring ``ring_of[i]``, whose segments are
+    ``ring_seg[r, :ring_len[r]]`` ((R, K, 4), padded).  ``base`` must be a domain with its
+    own grid (not itself extended).  Segment ``k`` of a ring is numbered ``len(base.seg) +
+    k``, as in the extended domain; -1 where a ray escapes.  Bit for bit the answers of
+    :func:`first_hits` on each extended domain (both run :func:`_first_hits_kernel`)."""
+    grid, n_base = grid_for(base)
+    if n_base != len(base.seg):
+        raise ValueError("first_hits_rings: base must not be an extended domain")
+    return _cast(grid, n_base, base.scale, ring_seg, ring_len, ring_of, q, phi)
+
+
+def _cast(
+    grid: SegmentGrid,
+    n_base: int,
+    scale: float,
+    ring_seg: np.ndarray,
+    ring_len: np.ndarray | list[int],
+    ring_of: np.ndarray,
+    q: np.ndarray,
+    phi: np.ndarray,
+) -> np.ndarray:
+    """Run :func:`_first_hits_kernel` (``tmin = 1e-11 scale``) on contiguous copies."""
     phi = np.ascontiguousarray(phi, dtype=np.float64)
     q = np.ascontiguousarray(np.broadcast_to(q, (len(phi), 2)), dtype=np.float64)
-    extra = np.ascontiguousarray(dom.seg[n_base:], dtype=np.float64)
     out = np.empty(len(phi), dtype=np.int64)
     _first_hits_kernel(
         q,
         phi,
+        np.ascontiguousarray(ring_of, dtype=np.int64),
+        np.ascontiguousarray(ring_seg, dtype=np.float64),
+        np.ascontiguousarray(ring_len, dtype=np.int64),
         grid.seg,
         grid.x0,
         grid.y0,
@@ -315,9 +366,8 @@ def first_hits(dom: Domain, q: np.ndarray, phi: np.ndarray) -> np.ndarray:
         grid.ny,
         grid.start,
         grid.items,
-        extra,
         n_base,
-        1e-11 * dom.scale,
+        1e-11 * scale,
         out,
     )
     return out
@@ -373,26 +423,44 @@ def blocking(dom: Domain, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.nda
     all points x all vertices and segments."""
     tol = 1e-12 * dom.scale
     q = np.asarray(q, dtype=float).reshape(-1, 2)
+    rows, cols = near_pairs(dom, q, 2.0 * tol)
+    # vertex j is the start of segment j (Domain.from_rings / with_ring)
+    return blocking_from_pairs(
+        q, rows, dom.vert[cols], dom.seg[cols], lambda m: dom.vert_wedge[cols[m]], tol
+    )
+
+
+def blocking_from_pairs(
+    q: np.ndarray,
+    rows: np.ndarray,
+    vert: np.ndarray,
+    seg: np.ndarray,
+    wedge_of: Callable[[np.ndarray], np.ndarray],
+    tol: float,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The ``w1, w2, along`` of :func:`blocking` for the points ``q`` (n, 2) from their
+    near (point, segment) pairs: pair ``k`` is point ``rows[k]`` (sorted) and the segment
+    ``seg[k]`` (x0, y0, x1, y1) whose start vertex is ``vert[k]``; ``wedge_of(mask)`` gives
+    the free wedges ``(start, width)`` (radians) of the start vertices of the pairs
+    selected by ``mask``.  Shared by :func:`blocking` (one domain) and
+    :func:`geometry._vis._blocking_rings` (each point in its own domain)."""
     n = len(q)
     w1 = np.full((n, 2), np.nan)
     w2 = np.full((n, 2), np.nan)
     along = np.full((n, 2), np.nan)
-    rows, cols = near_pairs(dom, q, 2.0 * tol)
     if len(rows) == 0:
         return w1, w2, along
-    # vertex j is the start of segment j (Domain.from_rings / with_ring)
-    vnear = np.abs(dom.vert[cols] - q[rows]).max(axis=1) <= tol
-    r, c = rows[vnear], cols[vnear]
+    vnear = np.abs(vert - q[rows]).max(axis=1) <= tol
+    r = rows[vnear]
     if len(r):
-        wedge = dom.vert_wedge[c]
+        wedge = wedge_of(vnear)
         first = np.concatenate([[True], r[1:] != r[:-1]])
         w1[r[first]] = wedge[first]
         second = ~first & np.concatenate([[False], first[:-1]])
         w2[r[second]] = wedge[second]
-    s = dom.seg[cols]
-    e = s[:, 2:] - s[:, :2]
+    e = seg[:, 2:] - seg[:, :2]
     L = np.hypot(e[:, 0], e[:, 1])
-    a = q[rows] - s[:, :2]
+    a = q[rows] - seg[:, :2]
     dist = np.abs(e[:, 0] * a[:, 1] - e[:, 1] * a[:, 0]) / np.maximum(L, 1e-300)
     t = (a[:, 0] * e[:, 0] + a[:, 1] * e[:, 1]) / np.maximum(L * L, 1e-300)
     on = (dist <= tol) & (t * L > tol) & ((1 - t) * L > tol)
@@ -705,127 +773,3 @@ def window_ranges(
         his.append(hi[:m])
         owns.append(ow[:m])
     return np.concatenate(los), np.concatenate(his), np.concatenate(owns)
-
-
-@_njit
-def _first_hits_rings_kernel(
-    q, phi, ring_of, ring_seg, ring_len, seg, x0, y0, h, nx, ny, start, items, extra_base, tmin, out
-):  # pragma: no cover
-    """:func:`_first_hits_kernel` with the added segments chosen per ray: ray ``i`` tests
-    ``ring_seg[ring_of[i], :ring_len[ring_of[i]]]`` (numbered from ``extra_base``).  The
-    statements are those of the one-domain kernel, so each ray's answer is bit for bit
-    what that kernel gives for the domain extended by the ray's own ring."""
-    for i in range(phi.shape[0]):
-        qx, qy = q[i, 0], q[i, 1]
-        dx, dy = math.cos(phi[i]), math.sin(phi[i])
-        best_t = math.inf
-        best = -1
-        r = ring_of[i]
-        for k in range(ring_len[r]):
-            t = _hit(
-                qx, qy, dx, dy, ring_seg[r, k, 0], ring_seg[r, k, 1], ring_seg[r, k, 2],
-                ring_seg[r, k, 3], tmin,
-            )  # fmt: skip
-            if t < best_t:
-                best_t = t
-                best = extra_base + k
-        if not (x0 <= qx <= x0 + nx * h and y0 <= qy <= y0 + ny * h):
-            for j in range(seg.shape[0]):
-                t = _hit(qx, qy, dx, dy, seg[j, 0], seg[j, 1], seg[j, 2], seg[j, 3], tmin)
-                if t < best_t or (t == best_t and j < best):
-                    best_t = t
-                    best = j
-            out[i] = best
-            continue
-        ix = int(math.floor((qx - x0) / h))
-        iy = int(math.floor((qy - y0) / h))
-        ix = max(0, min(nx - 1, ix))
-        iy = max(0, min(ny - 1, iy))
-        if dx > 0.0:
-            step_x = 1
-            t_max_x = (x0 + (ix + 1) * h - qx) / dx
-            t_dx = h / dx
-        elif dx < 0.0:
-            step_x = -1
-            t_max_x = (x0 + ix * h - qx) / dx
-            t_dx = -h / dx
-        else:
-            step_x = 0
-            t_max_x = math.inf
-            t_dx = math.inf
-        if dy > 0.0:
-            step_y = 1
-            t_max_y = (y0 + (iy + 1) * h - qy) / dy
-            t_dy = h / dy
-        elif dy < 0.0:
-            step_y = -1
-            t_max_y = (y0 + iy * h - qy) / dy
-            t_dy = -h / dy
-        else:
-            step_y = 0
-            t_max_y = math.inf
-            t_dy = math.inf
-        while True:
-            c = iy * nx + ix
-            for p in range(start[c], start[c + 1]):
-                j = items[p]
-                t = _hit(qx, qy, dx, dy, seg[j, 0], seg[j, 1], seg[j, 2], seg[j, 3], tmin)
-                if t < best_t or (t == best_t and j < best):
-                    best_t = t
-                    best = j
-            if t_max_x < t_max_y:
-                if best_t <= t_max_x:
-                    break
-                ix += step_x
-                if ix < 0 or ix >= nx:
-                    break
-                t_max_x += t_dx
-            else:
-                if best_t <= t_max_y:
-                    break
-                iy += step_y
-                if iy < 0 or iy >= ny:
-                    break
-                t_max_y += t_dy
-        out[i] = best
-
-
-def first_hits_rings(
-    base: Domain,
-    ring_seg: np.ndarray,
-    ring_len: np.ndarray,
-    ring_of: np.ndarray,
-    q: np.ndarray,
-    phi: np.ndarray,
-) -> np.ndarray:
-    """:func:`first_hits` for rays in several domains at once: ray ``i`` is cast in
-    ``base`` extended (:meth:`Domain.with_ring`) by ring ``ring_of[i]``, whose segments are
-    ``ring_seg[r, :ring_len[r]]`` ((R, K, 4), padded).  ``base`` must be a domain with its
-    own grid (not itself extended).  Segment ``k`` of a ring is numbered ``len(base.seg) +
-    k``, as in the extended domain; -1 where a ray escapes.  Bit for bit the answers of
-    :func:`first_hits` on each extended domain."""
-    grid, n_base = grid_for(base)
-    if n_base != len(base.seg):
-        raise ValueError("first_hits_rings: base must not be an extended domain")
-    phi = np.ascontiguousarray(phi, dtype=np.float64)
-    q = np.ascontiguousarray(np.broadcast_to(q, (len(phi), 2)), dtype=np.float64)
-    out = np.empty(len(phi), dtype=np.int64)
-    _first_hits_rings_kernel(
-        q,
-        phi,
-        np.ascontiguousarray(ring_of, dtype=np.int64),
-        np.ascontiguousarray(ring_seg, dtype=np.float64),
-        np.ascontiguousarray(ring_len, dtype=np.int64),
-        grid.seg,
-        grid.x0,
-        grid.y0,
-        grid.h,
-        grid.nx,
-        grid.ny,
-        grid.start,
-        grid.items,
-        n_base,
-        1e-11 * base.scale,
-        out,
-    )
-    return out

@@ -59,59 +59,19 @@ def weak_visibility(
     fans: list[shapely.Geometry] = []
     # 1. anchors on the target: endpoints of wanted pieces, seen from the front
     #    of a wanted edge at that vertex
-    edge = np.roll(ring, -1, axis=0) - ring
-    inc = np.stack([wanted, np.roll(wanted, 1)], axis=1)  # outgoing, incoming edge wanted
-    anchors = np.flatnonzero(inc.any(axis=1))
+    edge, anchors, extra, arcs = _target_anchors(ring, wanted, dom, len(env.vert))
     if len(anchors):
-        e_out, e_in = edge[anchors], np.roll(edge, 1, axis=0)[anchors]
-        dirs = np.stack([e_out, e_in], axis=1)  # (k, 2, 2)
-        ang = np.arctan2(dirs[..., 1], dirs[..., 0])
-        extra = np.concatenate([ang + np.pi, ang], axis=1)
-        # an anchor where an obstacle touches the target (a pinch) sees the edge beside it
-        # only where no touching polygon lies between the line of sight and the edge
-        arcs = _pinch_arcs(dom, len(env.vert) + anchors)
-        if arcs is not None:
-            extra = np.concatenate([extra, arcs[..., 0], arcs[..., 0] + arcs[..., 1]], axis=1)
         for k, (gi, i) in enumerate(
             zip(gaps_many(dom, ring[anchors], extra=extra), anchors, strict=False)
         ):
-            mid = 0.5 * (gi.lo + gi.hi)
-            d = np.stack([np.cos(mid), np.sin(mid)], axis=1)
-            front = np.zeros(len(mid), dtype=bool)
-            # the edge out of i runs along ``edge[i]``, the edge into i back along -edge[i-1]
-            for e, along, use in (
-                (edge[i], edge[i], wanted[i]),
-                (edge[i - 1], -edge[i - 1], wanted[i - 1]),
-            ):
-                if use:
-                    f = e[0] * d[:, 1] - e[1] * d[:, 0] > 0
-                    if arcs is not None:
-                        f &= ~_between(arcs[k], mid, float(np.arctan2(along[1], along[0])))
-                    front |= f
+            front = _front(gi, edge, wanted, i, None if arcs is None else arcs[k])
             fans += _fans(gi, front & (gi.seg >= 0), dom, eps_aim)
     n_direct = len(fans)
     # 2. grazing anchors: reflex vertices v of the free space around the target;
     #    first the directions in which v sees a wanted piece ...
-    v_idx = np.flatnonzero(dom.reflex)
-    if grazing is not None:
-        v_idx = v_idx[(v_idx >= len(env.vert)) | grazing[np.minimum(v_idx, len(env.vert) - 1)]]
-    v = dom.vert[v_idx]
-    if len(v):
-        rel = np.arctan2(ring[None, :, 1] - v[:, None, 1], ring[None, :, 0] - v[:, None, 0])
-        centre = ring.mean(axis=0)
-        base = np.arctan2(centre[1] - v[:, 1], centre[0] - v[:, 0])
-        rel = (rel - base[:, None] + np.pi) % TAU - np.pi
-        on_target = np.abs(ring[None, :, :] - v[:, None, :]).max(axis=2) <= 1e-12 * dom.scale
-        lo = np.where(on_target, np.inf, rel).min(axis=1)
-        hi = np.where(on_target, -np.inf, rel).max(axis=1)
-        ok = hi - lo > 1e-12
-        v, sectors = v[ok], np.stack([base[ok] + lo[ok], hi[ok] - lo[ok]], axis=1)
-        # a line through a pinch (polygons touching at v) passes between them: blocked
-        arcs = _pinch_arcs(dom, v_idx[ok])
-        extra = None
-        if arcs is not None:  # split the gaps where a line through v starts to separate
-            a0, a1 = arcs[..., 0], arcs[..., 0] + arcs[..., 1]
-            extra = np.concatenate([a0, a1, a0 - np.pi, a1 - np.pi], axis=1)
+    grz = _grazing_anchors(ring, dom, grazing, len(env.vert))
+    if grz is not None:
+        v, sectors, extra, arcs = grz
         g, off = gaps_many(dom, v, sectors=sectors, extra=extra, flat=True)
         sees = (g.seg >= 0) & (dom.seg_tag[np.maximum(g.seg, 0)] == WANTED)
         if arcs is not None:
@@ -138,6 +98,85 @@ def weak_visibility(
     if not fans:
         return shapely.Polygon()
     return _union(fans, n_first=n_direct)
+
+
+def _target_anchors(
+    ring: np.ndarray, wanted: np.ndarray, dom: Domain, nv: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, np.ndarray | None]:
+    """Step 1 of :func:`weak_visibility`: the anchors on the target (indices into
+    ``ring`` of the endpoints of wanted pieces), with ``edge`` (the (m, 2) edge vectors
+    ``ring[i+1] - ring[i]``), the extra critical directions of each anchor (radians:
+    along and against both edges at it, and the sides of its pinch arcs) and the pinch
+    arcs (or None).  ``dom`` is the domain with the target as a hole after the ``nv``
+    vertices of the free space.  ``extra`` is None when there are no anchors."""
+    edge = np.roll(ring, -1, axis=0) - ring
+    inc = np.stack([wanted, np.roll(wanted, 1)], axis=1)  # outgoing, incoming edge wanted
+    anchors = np.flatnonzero(inc.any(axis=1))
+    if not len(anchors):
+        return edge, anchors, None, None
+    e_out, e_in = edge[anchors], np.roll(edge, 1, axis=0)[anchors]
+    dirs = np.stack([e_out, e_in], axis=1)  # (k, 2, 2)
+    ang = np.arctan2(dirs[..., 1], dirs[..., 0])
+    extra = np.concatenate([ang + np.pi, ang], axis=1)
+    # an anchor where an obstacle touches the target (a pinch) sees the edge beside it
+    # only where no touching polygon lies between the line of sight and the edge
+    arcs = _pinch_arcs(dom, nv + anchors)
+    if arcs is not None:
+        extra = np.concatenate([extra, arcs[..., 0], arcs[..., 0] + arcs[..., 1]], axis=1)
+    return edge, anchors, extra, arcs
+
+
+def _front(
+    gi: Gaps, edge: np.ndarray, wanted: np.ndarray, i: int, arcs: np.ndarray | None
+) -> np.ndarray:
+    """The gaps of anchor ``ring[i]`` that look out of the front of a wanted edge at it
+    (bool per gap); ``arcs``: the anchor's pinch arcs (radians) or None."""
+    mid = 0.5 * (gi.lo + gi.hi)
+    d = np.stack([np.cos(mid), np.sin(mid)], axis=1)
+    front = np.zeros(len(mid), dtype=bool)
+    # the edge out of i runs along ``edge[i]``, the edge into i back along -edge[i-1]
+    for e, along, use in (
+        (edge[i], edge[i], wanted[i]),
+        (edge[i - 1], -edge[i - 1], wanted[i - 1]),
+    ):
+        if use:
+            f = e[0] * d[:, 1] - e[1] * d[:, 0] > 0
+            if arcs is not None:
+                f &= ~_between(arcs, mid, float(np.arctan2(along[1], along[0])))
+            front |= f
+    return front
+
+
+def _grazing_anchors(
+    ring: np.ndarray, dom: Domain, grazing: np.ndarray | None, nv: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, np.ndarray | None] | None:
+    """Step 2 of :func:`weak_visibility`: the grazing anchors (reflex vertices of ``dom``,
+    those of the free space's ``nv`` first ones filtered by ``grazing``) that see the
+    target under a positive angle, with their sectors ``(start, width)`` (radians)
+    towards it, the extra critical directions of their pinch arcs (or None) and the arcs
+    (or None).  None when ``dom`` has no candidate vertex at all."""
+    v_idx = np.flatnonzero(dom.reflex)
+    if grazing is not None:
+        v_idx = v_idx[(v_idx >= nv) | grazing[np.minimum(v_idx, nv - 1)]]
+    v = dom.vert[v_idx]
+    if not len(v):
+        return None
+    rel = np.arctan2(ring[None, :, 1] - v[:, None, 1], ring[None, :, 0] - v[:, None, 0])
+    centre = ring.mean(axis=0)
+    base = np.arctan2(centre[1] - v[:, 1], centre[0] - v[:, 0])
+    rel = (rel - base[:, None] + np.pi) % TAU - np.pi
+    on_target = np.abs(ring[None, :, :] - v[:, None, :]).max(axis=2) <= 1e-12 * dom.scale
+    lo = np.where(on_target, np.inf, rel).min(axis=1)
+    hi = np.where(on_target, -np.inf, rel).max(axis=1)
+    ok = hi - lo > 1e-12
+    v, sectors = v[ok], np.stack([base[ok] + lo[ok], hi[ok] - lo[ok]], axis=1)
+    # a line through a pinch (polygons touching at v) passes between them: blocked
+    arcs = _pinch_arcs(dom, v_idx[ok])
+    extra = None
+    if arcs is not None:  # split the gaps where a line through v starts to separate
+        a0, a1 = arcs[..., 0], arcs[..., 0] + arcs[..., 1]
+        extra = np.concatenate([a0, a1, a0 - np.pi, a1 - np.pi], axis=1)
+    return v, sectors, extra, arcs
 
 
 def _pinch_arcs(dom: Domain, idx: np.ndarray) -> np.ndarray | None:
@@ -490,19 +529,10 @@ def weak_visibility_many(
     # 1. anchors on the targets (weak_visibility, step 1)
     q1, e1, own1, meta1 = [], [], [], []
     for r, (ring, wnt, dom) in enumerate(zip(rings, wanted, doms, strict=True)):
-        edge = np.roll(ring, -1, axis=0) - ring
-        inc = np.stack([wnt, np.roll(wnt, 1)], axis=1)
-        anchors = np.flatnonzero(inc.any(axis=1))
+        edge, anchors, extra, arcs = _target_anchors(ring, wnt, dom, nv)
         if not len(anchors):
             meta1.append(None)
             continue
-        e_out, e_in = edge[anchors], np.roll(edge, 1, axis=0)[anchors]
-        dirs = np.stack([e_out, e_in], axis=1)
-        ang = np.arctan2(dirs[..., 1], dirs[..., 0])
-        extra = np.concatenate([ang + np.pi, ang], axis=1)
-        arcs = _pinch_arcs(dom, nv + anchors)
-        if arcs is not None:
-            extra = np.concatenate([extra, arcs[..., 0], arcs[..., 0] + arcs[..., 1]], axis=1)
         q1.append(ring[anchors])
         e1.append(extra)
         own1.append(np.full(len(anchors), r))
@@ -521,18 +551,7 @@ def weak_visibility_many(
         for k, i in enumerate(anchors):
             gi = _slice(g1, off1[row], off1[row + 1], qs1[row])
             row += 1
-            mid = 0.5 * (gi.lo + gi.hi)
-            d = np.stack([np.cos(mid), np.sin(mid)], axis=1)
-            front = np.zeros(len(mid), dtype=bool)
-            for e, along, use in (
-                (edge[i], edge[i], wnt[i]),
-                (edge[i - 1], -edge[i - 1], wnt[i - 1]),
-            ):
-                if use:
-                    f = e[0] * d[:, 1] - e[1] * d[:, 0] > 0
-                    if arcs is not None:
-                        f &= ~_between(arcs[k], mid, float(np.arctan2(along[1], along[0])))
-                    front |= f
+            front = _front(gi, edge, wnt, i, None if arcs is None else arcs[k])
             if flat:
                 masks.append(front & (gi.seg >= 0))
             else:
@@ -546,27 +565,11 @@ def weak_visibility_many(
     # 2. grazing anchors (weak_visibility, step 2): the directions that see a wanted piece
     q2, s2, e2, own2, meta2 = [], [], [], [], []
     for r, (ring, dom) in enumerate(zip(rings, doms, strict=True)):
-        v_idx = np.flatnonzero(dom.reflex)
-        if grazing is not None:
-            v_idx = v_idx[(v_idx >= nv) | grazing[np.minimum(v_idx, nv - 1)]]
-        v = dom.vert[v_idx]
-        if not len(v):
+        grz = _grazing_anchors(ring, dom, grazing, nv)
+        if grz is None:
             meta2.append(None)
             continue
-        rel = np.arctan2(ring[None, :, 1] - v[:, None, 1], ring[None, :, 0] - v[:, None, 0])
-        centre = ring.mean(axis=0)
-        base = np.arctan2(centre[1] - v[:, 1], centre[0] - v[:, 0])
-        rel = (rel - base[:, None] + np.pi) % TAU - np.pi
-        on_target = np.abs(ring[None, :, :] - v[:, None, :]).max(axis=2) <= 1e-12 * dom.scale
-        lo = np.where(on_target, np.inf, rel).min(axis=1)
-        hi = np.where(on_target, -np.inf, rel).max(axis=1)
-        ok = hi - lo > 1e-12
-        v, sectors = v[ok], np.stack([base[ok] + lo[ok], hi[ok] - lo[ok]], axis=1)
-        arcs = _pinch_arcs(dom, v_idx[ok])
-        extra = None
-        if arcs is not None:
-            a0, a1 = arcs[..., 0], arcs[..., 0] + arcs[..., 1]
-            extra = np.concatenate([a0, a1, a0 - np.pi, a1 - np.pi], axis=1)
+        v, sectors, extra, arcs = grz
         q2.append(v)
         s2.append(sectors)
         e2.append(extra if extra is not None else np.zeros((len(v), 0)))
