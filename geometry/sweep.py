@@ -317,11 +317,19 @@ class Sweeper:
         all_keys = np.full((len(flat), 2), -1, dtype=np.int64)
         if need.any():
             all_keys[need] = self._label(flat[need], table, tid, d=d[need])
-        for r, v in enumerate(vs):
+        for r in range(len(vs)):
             keys = all_keys[off[r] : off[r + 1]]
+            # consecutive edges on one line (the same key) are one shadow edge: the overlay
+            # can leave a vertex inside an edge (a node of another ring, a hot pixel), and
+            # its pieces would each see their own line as a neighbour and be dropped below
+            # (a shadow traced in one frame and missed in another, fuzz seed 8103)
+            same = (keys == np.roll(keys, 1, axis=0)).all(axis=1) & (keys >= 0).all(axis=1)
+            if same.all():
+                continue
+            keys = keys[~same]
             moving = (keys >= n).any(axis=1) & (keys >= 0).all(axis=1)
             for i in np.flatnonzero(moving):
-                kp, kn = keys[i - 1], keys[(i + 1) % len(v)]
+                kp, kn = keys[i - 1], keys[(i + 1) % len(keys)]
                 if min(kp) < 0 or min(kn) < 0 or set(kp) == set(keys[i]) or set(kn) == set(keys[i]):
                     continue
                 out.append((tuple(kp), tuple(keys[i]), tuple(kn)))
@@ -1332,21 +1340,38 @@ def _rot(v: np.ndarray) -> np.ndarray:
 
 def star_center(ring: np.ndarray) -> np.ndarray | None:
     """A point of the kernel of the polygon ``ring`` (counter-clockwise), preferring
-    the origin; None when the polygon is not star-shaped."""
-    e = np.roll(ring, -1, axis=0) - ring
+    the origin; None when the polygon is not star-shaped (its kernel has no area above
+    ``1e-12`` of the squared size of the ring).
+
+    Frame-free: the half-planes are built around the ring's own centre with unit edge
+    directions and extents relative to its size, so scaling or moving the ring scales or
+    moves the answer (an absolute ``+ 1`` in the extents and edge vectors used as
+    directions once cut the kernel of a small target: a star-shaped target of a scene
+    scaled by 1e-3 swept as its convex hull, fuzz seed 200033)."""
+    ring = np.asarray(ring, dtype=float)
     if (_cross(ring, np.roll(ring, -1, axis=0)) >= 0).all():
         return np.zeros(2)
-    big = 4 * float(np.abs(ring).max()) + 1.0
+    mid = 0.5 * (ring.min(axis=0) + ring.max(axis=0))
+    r = ring - mid
+    size = float(np.hypot(r[:, 0], r[:, 1]).max())
+    if not size > 0:
+        return None
+    big = 4.0 * size  # every point within ``size`` of mid projects within 2 size of a
     ker = shapely.box(-big, -big, big, big)
-    for a, d in zip(ring, e, strict=True):
-        n = _rot(d) / np.hypot(*d)  # inward normal (ccw ring)
+    e = np.roll(r, -1, axis=0) - r
+    for a, d in zip(r, e, strict=True):
+        ln = float(np.hypot(*d))
+        if not ln > 0:
+            continue
+        u = d / ln
+        n = _rot(u)  # inward normal (ccw ring)
         half = shapely.Polygon(
-            [a - d * big, a + d * big, a + d * big + n * big, a - d * big + n * big]
+            [a - u * big, a + u * big, a + u * big + n * big, a - u * big + n * big]
         )
         ker = shapely.intersection(ker, half)
-    if ker.is_empty or ker.area <= 1e-12 * big * big:
+    if ker.is_empty or ker.area <= 1e-12 * size * size:
         return None
-    return np.asarray(ker.centroid.coords[0])
+    return np.asarray(ker.centroid.coords[0]) + mid
 
 
 def swept_shadows(
