@@ -157,7 +157,7 @@ def _attached_evaluation_matches(tmp_path, want):
         env=env,
         capture_output=True,
         text=True,
-        timeout=300,
+        timeout=900,  # minutes on a loaded 2-core machine (108 s alone)
     )
     assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-2000:]
     got = json.loads(run_file(tmp_path / "attached", TINY.env_id, "ppo", 0).read_text())
