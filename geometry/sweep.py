@@ -43,8 +43,11 @@ component that neither neighbouring shadow meets (a shadow born and gone in
 between), and once between consecutive *collinearity events* (:meth:`Sweeper._events`:
 a moving anchor crossing a line through two obstacle corners or an obstacle edge, a line
 through two target vertices crossing a corner), where a shadow can be born as a segment
-that continues a known shadow edge (issue 26.3, 26.4).  What this does not prove is
-listed in docs/DESIGN.md.
+that continues a known shadow edge (issue 26.3, 26.4), and just after a traced edge was
+cut short by the death of a neighbour while its line still bounds a shadow (the edge goes
+on with another neighbour, a configuration that may live between two samples only:
+:meth:`Sweeper._continuation_gap`).  What this does not prove is listed in
+docs/DESIGN.md.
 """
 
 from __future__ import annotations
@@ -76,6 +79,10 @@ GRID_BITS = 40
 #: computed by snap-rounding onto a grid ``2**-SHADOW_BITS`` finer than the union's:
 #: see :meth:`Sweeper.shadow`.
 SHADOW_BITS = 8
+
+#: A traced edge that dies between samples while still this long relative to its length
+#: at its sample was cut short by a neighbour's change: see :meth:`Sweeper._cut_short`.
+CUT_REL = 1e-3
 
 #: The bisection of a traced edge's death time tests this many levels of its binary
 #: tree of midpoints in one batch: see :meth:`Sweeper._bisect`.
@@ -610,6 +617,8 @@ class Sweeper:
         # (t, key): an edge on that line at sample t is confirmed by the exact point test
         # (its trace lives past t) or swept inside the known shadows
         confirmed: set[tuple] = set()
+        traced: dict[tuple, list] = {}  # key -> the intervals its traces reached
+        probed: list[tuple] = []  # (key, t_end) of the cut traces already sampled after
         todo = [(a, b, 0) for a, b in zip(ts[:-1], ts[1:], strict=True)]
         while todo:
             self._check_time()
@@ -618,15 +627,18 @@ class Sweeper:
             # collapsed edges (LineStrings), and an overlay with such a collection fails
             # ("Result area inconsistent with overlay operation", fuzz seed 501057)
             known = None  # the shadows' union, only if their X (see _uncovered_seen) is not kept
+            cut: list[tuple] = []  # (key, t_end, toward): traces ended by a neighbour's change
             for t, toward in ((a, b), (b, a)):
                 edges = self._uncovered_seen(frame(t)[1], t, toward, (a, b), q0, q1)
                 if edges is None:
                     if known is None:
                         known = areal(shapely.union(frame(a)[0], frame(b)[0]))
                     edges = self._uncovered(frame(t)[1], t, toward, known, q0, dq)
-                for e in frame(t)[1]:
-                    if e not in edges:  # swept inside the known shadows: nothing to trace
-                        cover.setdefault(e[1], []).append((a, b))
+                inside = [e for e in frame(t)[1] if e not in edges]
+                for e in inside:  # swept inside the known shadows: nothing to trace
+                    cover.setdefault(e[1], []).append((a, b))
+                for e in self._not_point(inside, t, q0, dq):
+                    traced.setdefault(e[1], []).append((a, b))
                 quads, ends = self._trace_many(edges, t, toward, q0, dq)
                 stats["edges"] += len(edges)
                 pieces.extend(quads)
@@ -634,8 +646,14 @@ class Sweeper:
                     cover.setdefault(e[1], []).append((min(t, end), max(t, end)))
                     if end != t:
                         confirmed.add((t, e[1]))
+                        traced.setdefault(e[1], []).append((min(t, end), max(t, end)))
+                    else:  # not confirmed even at its own sample: tracing cannot cover it
+                        traced.setdefault(e[1], []).append((a, b))
+                cut += self._cut_short(edges, ends, t, toward, q0, dq)
                 confirmed.update((t, e[1]) for e in frame(t)[1] if e not in edges)
             gap = self._coverage_gap(frame(a)[1], frame(b)[1], cover, a, b, confirmed)
+            if gap is None:
+                gap = self._continuation_gap(cut, traced, probed, q0, dq)
             if gap is not None and depth < self.max_depth:
                 frame(gap)
                 stats["refined"] += 1
@@ -789,16 +807,33 @@ class Sweeper:
         if self.deadline is not None and time.monotonic() > self.deadline:
             raise _Expired
 
+    def _strips(
+        self, edges: list, t: float, toward: float, q0, dq
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """The areas the shadow edges ``edges`` (found at sample ``t``) would sweep from
+        ``t`` to ``toward`` if they lived that long, as valid polygons, and per edge
+        whether its ends are finite there (an edge that is not must be traced).
+
+        Each is the strip between the paths of the edge's two ends, on the time grid of
+        :meth:`_grid` (chords within ``tol`` of the paths): not the quadrilateral of
+        its first and last positions.  An edge that pivots on a fixed corner while its
+        far end runs out and back sweeps a fan whose first and last positions nearly
+        coincide; that quadrilateral has no area, the edge was taken as swept inside the
+        known shadows and not traced, and the fan was missed (fuzz seeds 203869,
+        204155: a shadow ~4e-5 D deep kept in the ``conservative=True`` region)."""
+        ts = self._grid(edges, min(t, toward), max(t, toward), q0, dq)
+        vs, ve = self._ends_many(edges, ts[None, :], q0, dq)  # (E, T, 2) each
+        ring = np.concatenate([vs, ve[:, ::-1]], axis=1)
+        ok = np.isfinite(ring).all(axis=(1, 2))
+        polys = shapely.make_valid(shapely.polygons(np.where(ok[:, None, None], ring, 0.0)))
+        return polys, ok
+
     def _uncovered(self, edges: list, t: float, toward: float, known, q0, dq) -> list:
         """The edges whose sweep from t to ``toward`` (assuming it lives that long)
         is not already inside ``known`` (rotating into their own shadow)."""
         if not edges:
             return []
-        vs, ve = self._ends_many(edges, np.array([[t, toward]]), q0, dq)  # (E, 2, 2) each
-        quads = np.stack([vs[:, 0], vs[:, 1], ve[:, 1], ve[:, 0]], axis=1)
-        ok = np.isfinite(quads).all(axis=(1, 2))
-        polys = shapely.polygons(np.where(ok[:, None, None], quads, 0.0))
-        polys = shapely.make_valid(polys)
+        polys, ok = self._strips(edges, t, toward, q0, dq)
         shapely.prepare(known)
         rest = shapely.area(shapely.difference(polys, known))
         need = ~ok | (rest > 1e-9 * self.env.scale**2)
@@ -826,11 +861,7 @@ class Sweeper:
         inter = self._seen_pair(ka, kb)
         if inter is None:
             return None
-        dq = q1 - q0
-        vs, ve = self._ends_many(edges, np.array([[t, toward]]), q0, dq)  # (E, 2, 2) each
-        quads = np.stack([vs[:, 0], vs[:, 1], ve[:, 1], ve[:, 0]], axis=1)
-        ok = np.isfinite(quads).all(axis=(1, 2))
-        polys = shapely.make_valid(shapely.polygons(np.where(ok[:, None, None], quads, 0.0)))
+        polys, ok = self._strips(edges, t, toward, q0, q1 - q0)
         grown, band = self._free_grown_eps()
         rest = np.zeros(len(polys))
         idx = np.flatnonzero(ok)
@@ -874,6 +905,82 @@ class Sweeper:
             shapely.prepare(grown)
             got = self._free_eps = (grown, 2.0 * eps * float(shapely.length(self.free)))
         return got
+
+    def _cut_short(self, edges: list, ends: list, t: float, toward: float, q0, dq) -> list:
+        """``(edge, t_end, toward)`` for the traced ``edges`` whose trace from ``t`` ended
+        at ``t_end`` strictly between ``t`` and ``toward`` while the edge still had length
+        (at least ``CUT_REL`` of its length at ``t``): not a shadow edge that shrank to a
+        point, but one whose neighbouring edge died, so that its line goes on bounding the
+        shadow with another neighbour (:meth:`_continuation_gap`)."""
+        span = abs(toward - t)
+        idx = [
+            i for i, end in enumerate(ends)
+            if end != t and abs(end - toward) > 1e-9 * span
+        ]  # fmt: skip
+        if not idx:
+            return []
+        sub = [edges[i] for i in idx]
+        te = np.array([[t, ends[i]] for i in idx])
+        vs, ve = self._ends_many(sub, te, q0, dq)
+        ln = np.hypot(*np.moveaxis(ve - vs, -1, 0))  # (E, 2): at t and at the end
+        long_ = np.isfinite(ln).all(axis=1) & (ln[:, 1] > CUT_REL * ln[:, 0])
+        return [(sub[k], ends[i], toward) for k, i in enumerate(idx) if long_[k]]
+
+    def _not_point(self, edges: list, t: float, q0, dq) -> list:
+        """The ``edges`` longer than ``1e-6`` of the scene's size at time ``t``: a shadow
+        edge that is a point there (its neighbours' lines meet on its own) sweeps nothing
+        in any configuration and tells nothing of the line's other configurations."""
+        if not edges:
+            return []
+        vs, ve = self._ends_many(edges, np.array([[t]]), q0, dq)
+        ln = np.hypot(*np.moveaxis(ve[:, 0] - vs[:, 0], -1, 0))
+        return [e for e, n_ in zip(edges, ln > 1e-6 * self.env.scale, strict=True) if n_]
+
+    def _continuation_gap(self, cut: list, traced: dict, probed: list, q0, dq) -> float | None:
+        """A time just after a trace was cut short (:meth:`_cut_short`) at ``t_end``
+        where the cut edge's line still bounds a shadow and no trace of that line has
+        reached (nor an edge on it found swept inside the known shadows,
+        :meth:`_not_point`, or one that the exact point test does not confirm even at
+        its own sample: see :meth:`_coverage_gap`), or None.
+
+        When a neighbouring edge dies, the edge's line goes on bounding the shadow with
+        another neighbour from ``t_end`` on, and that configuration can be born and gone
+        between two samples (the line's edge at the next sample, if any, then has other
+        neighbours, or has collapsed; fuzz seed 204155: a sliver shadow 0.014 D long,
+        missed at every sample).  A sample a tenth of the way from ``t_end`` to the next
+        sample finds it and traces it both ways.  It is taken where the exact point test
+        confirms, at that time, a twentieth of the cut edge at either end (the end whose
+        neighbour lives on is still right, and the new edge runs from it): a line that
+        bounds no shadow there has no continuation.  Each death (``probed``: key and
+        time, within ``1e-6`` of the sweep) is looked at once."""
+        todo = []
+        for edge, t_end, toward in cut:
+            key = edge[1]
+            lo, hi = min(t_end, toward), max(t_end, toward)
+            if hi - lo <= 1e-6 or any(k == key and abs(t - t_end) <= 1e-6 for k, t in probed):
+                continue
+            probed.append((key, t_end))
+            iv = sorted(
+                (max(x, lo), min(y, hi)) for x, y in traced.get(key, []) if y > lo and x < hi
+            )
+            # is the time just after t_end (towards ``toward``) held by no trace?
+            if toward > t_end:
+                free = not iv or iv[0][0] > lo + 1e-9
+            else:
+                free = not iv or iv[-1][1] < hi - 1e-9
+            if free:
+                todo.append((edge, t_end + 0.1 * (toward - t_end)))
+        if not todo:
+            return None
+        tp = np.array([[t] for _, t in todo])
+        vs, ve = self._ends_many([e for e, _ in todo], tp, q0, dq)  # (E, 1, 2) each
+        d = 0.05 * (ve - vs)
+        near = self._valid_many(
+            np.concatenate([vs, ve - d]), np.concatenate([vs + d, ve]), np.vstack([tp, tp]), q0, dq
+        )[:, 0]
+        finite = np.isfinite(d).all(axis=(1, 2))
+        go = ~finite | near[: len(todo)] | near[len(todo) :]
+        return float(tp[np.argmax(go), 0]) if go.any() else None
 
     def _coverage_gap(
         self, ea: list, eb: list, cover: dict, a: float, b: float, confirmed: set
@@ -1329,9 +1436,42 @@ def _drop_short(v: np.ndarray, length: float) -> np.ndarray:
                     keep.append(i)
             elif np.abs(v[i] - v[keep[-1]]).max() >= length:
                 keep.append(i)
+    tail = len(v)  # the vertices from ``tail`` on join vertex 0's cluster (the ring closes)
     while len(keep) > 1 and np.abs(v[keep[-1]] - v[0]).max() < length:
-        keep.pop()
-    return v[keep]
+        tail = keep.pop()
+    if len(keep) == len(v):
+        return v
+    return _corners(v, keep, tail, length)
+
+
+def _corners(v: np.ndarray, keep: list, tail: int, length: float) -> np.ndarray:
+    """The kept vertices of :func:`_drop_short`, each moved to the corner of its cluster
+    (itself and the vertices dropped after it, ``tail ..`` joining vertex 0): where the
+    line of the edge entering the cluster meets that of the edge leaving it, when those
+    lines cross within ``4 length`` of the kept vertex.  Keeping the cluster's first
+    vertex instead left a ring whose edge from it is off its own line by the split (fuzz
+    seed 203978: 6e-9 of 8.6e-9 allowed), so the edge got no label, its neighbour was
+    dropped as unlabelled, and that shadow edge was traced in one frame and not in
+    another."""
+    n = len(v)
+    out = v[keep].copy()
+    ends = keep[1:] + [tail]
+    for j, (k, nxt) in enumerate(zip(keep, ends, strict=True)):
+        first = tail % n if j == 0 and tail < n else k  # the cluster's first vertex
+        last = nxt - 1  # and its last
+        if first == last:
+            continue
+        a0, a1 = v[first - 1], v[first]
+        b0, b1 = v[last], v[(last + 1) % n]
+        da, db = a1 - a0, b1 - b0
+        den = float(da[0] * db[1] - da[1] * db[0])
+        if den == 0.0:
+            continue
+        u = float((b0[0] - a0[0]) * db[1] - (b0[1] - a0[1]) * db[0]) / den
+        c = a0 + u * da
+        if np.isfinite(c).all() and np.abs(c - v[k]).max() <= 4.0 * length:
+            out[j] = c
+    return out
 
 
 def _rot(v: np.ndarray) -> np.ndarray:

@@ -273,7 +273,11 @@ def _swept_frame_diff(seed: int, query: str, frame: str) -> float:
 #: 200929 -- the overlay left a vertex inside a moving shadow edge in one frame; each piece
 #: saw its own line as a neighbour and ``Sweeper._edges`` dropped both, so the edge was not
 #: traced (8.5e-7 to 1.1e-4 D^2 of shadow missed; the pieces are merged now).  200755 -- both
-#: (either fix alone removes it).
+#: (either fix alone removes it).  203978 (from the longer run, seeds 201200-204449) -- a
+#: shadow corner split by 6e-9 (below the labels' 8.6e-9): ``_drop_short`` kept the split's
+#: first vertex, off the next edge's line, so that edge got no label and its neighbour was
+#: dropped; the base frame, not the UTM one, missed 1.2e-4 D^2 of shadow (the corner is
+#: now where the two lines meet, ``sweep._corners``).
 SWEPT_FRAME_SEEDS = [
     (200033, "recognizable 5.2", "scale1e-3"),
     (200323, "partial in", "scale1e-3"),
@@ -284,6 +288,7 @@ SWEPT_FRAME_SEEDS = [
     (200596, "partial in", "utm"),
     (200755, "recognizable 5.2", "scale1e3"),
     (200929, "partial in", "scale1e-3"),
+    (203978, "recognizable 5.2", "utm"),
 ]
 
 
@@ -311,3 +316,84 @@ def test_star_center_is_frame_free():
         ck = star_center(ring * k + off)
         assert ck is not None, (k, off)
         assert np.allclose(ck, c * k + off, rtol=0, atol=1e-9 * k), (k, off, ck, c * k + off)
+
+
+def test_split_corner_keeps_the_lines():
+    """``_drop_short`` merges a corner split by rounding into the point where the lines
+    of the edges on either side meet, not into the split's first vertex (fuzz seed
+    203978: that vertex was 6e-9 off the next edge's line and the edge went unlabelled)."""
+    import numpy as np
+
+    from geometry.sweep import _drop_short
+
+    corner = np.array([0.5587027499712555, 0.2339677110594749])
+    ring = np.array(
+        [[0.5587027436122298, 0.23396770912222564], [0.5587027452420443, 0.23396770330145955],
+         [0.6022970464955613, 0.3054817991870671], [0.5181139863561839, 0.22160252230241895]]
+    )  # fmt: skip
+    got = _drop_short(ring, 8.6e-9)
+    assert len(got) == 3
+    assert np.abs(got[0] - corner).max() < 1e-15
+    # the same split across the ring's closing edge, and a ring without a split
+    rolled = np.roll(ring, -1, axis=0)
+    got = _drop_short(rolled, 8.6e-9)
+    assert len(got) == 3 and np.abs(got - corner).max(axis=1).min() < 1e-15
+    assert np.array_equal(_drop_short(ring[1:], 8.6e-9), ring[1:])
+
+
+#: Seeds of the longer swept run (201200-204449) whose ``partial_region(target_in="goal",
+#: conservative=True)`` held placements blind at a configuration between the sweep's
+#: samples ("translating ⊆ stationary at sampled q (partial)", 3.5e-8 and 1.6e-6 D^2):
+#: 203869 -- an edge pivoting on a corner whose far end ran out and back was taken as
+#: swept inside the known shadows, from the quadrilateral of its first and last positions
+#: (``Sweeper._strips`` now follows its ends on the tracing grid); 204155 -- a shadow edge
+#: whose neighbour died went on with another neighbour, a configuration born and gone
+#: between two samples (``Sweeper._cut_short``, ``_continuation_gap``).
+SWEPT_INCLUSION_SEEDS = [203869, 204155]
+
+
+@pytest.mark.parametrize("seed", SWEPT_INCLUSION_SEEDS)
+def test_swept_inclusion_seeds(seed):
+    d = fuzz_scene(seed, contacts=True)
+    findings, _ = check_scene(d, seed=seed, hang_s=120.0, swept=True)
+    assert not [vars(f) for f in findings], findings
+
+
+def test_swept_5_2_frame_seed_is_right_in_the_base_frame():
+    """Seed 203978: the placement that only the base frame's 5.2 region held is blind to
+    every wanted point of the target at a configuration on H's boundary (a brute force over
+    the target's outline minus the overlap strips); the region now excludes it."""
+    import math
+
+    import numpy as np
+    import shapely
+
+    from geometry._shapes import ccw_ring
+    from geometry.fuzz import _clear_lines
+    from geometry.recognize import _accuracy, overlap_strips
+
+    d = {k: v for k, v in fuzz_scene(203978, contacts=True).items() if k != "features"}
+    s = Scene.from_dict(d)
+    rng = np.random.default_rng(203978)
+    theta = float(rng.uniform(-math.pi, math.pi)) if rng.random() < 0.5 else 0.0
+    p = np.array([9.547096177088465, 4.700004951139725])
+    q = np.array([7.38208994, 2.08])  # on H's boundary, mid-way through the blind stretch
+    assert s.failure_geom.exterior.distance(shapely.Point(q)) < 1e-6
+    target = ccw_ring(s.target_at(0.0, 0.0, theta))
+    strips = overlap_strips(target, s.region("goal"), *_accuracy(s))
+    ring = target + q
+    f = (np.arange(400) + 0.5) / 400
+    wanted = []
+    for i in range(len(ring)):
+        edge = shapely.LineString([ring[i], ring[(i + 1) % len(ring)]])
+        for g in shapely.get_parts(shapely.difference(edge, strips[i])):
+            if g.length > 0:
+                c = np.asarray(g.coords)
+                wanted.append(c[0] + f[:, None] * (c[-1] - c[0]))
+    seen = _clear_lines(
+        p, np.vstack(wanted), s.obstacle_union, s.bounds_geom, shapely.Polygon(ring),
+        1e-9 * s.diameter,
+    )  # fmt: skip
+    assert not seen.any()
+    r52 = recognizable_region(s, model="partial", theta=theta)
+    assert not shapely.intersects_xy(r52, *p)
