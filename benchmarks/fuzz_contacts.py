@@ -48,14 +48,12 @@ def main(argv: list[str] | None = None) -> None:
     _results.write("fuzz_contacts", data, args.out, args.update_results)
 
 
-def render(data: dict[str, Any]) -> str:
-    """The page fragment: scenes fuzzed and violations per kind."""
+def summary(data: dict[str, Any], head: str) -> str:
+    """A fuzz fragment: ``head`` (what was fuzzed), the violations per kind (``KINDS``) as a
+    one-row table, the command, and the first 20 failing seeds if any."""
     v = data["violations"]
-    a, b = data["seeds"]
-    what = "every query type" if data["swept"] else "every query type but the swept partial ones"
     lines = [
-        f"Seeds {a}-{b}: {data['valid']} valid scenes of {data['scenes']}, {what}, each scene "
-        f"in four frames; {data['seconds']:.0f} s with {data['jobs']} processes.",
+        head,
         "",
         "| " + " | ".join(KINDS) + " |",
         "|" + "---|" * len(KINDS),
@@ -67,6 +65,17 @@ def render(data: dict[str, Any]) -> str:
         seeds = ", ".join(str(f["seed"]) for f in data["failing_scenes"][:20])
         lines += ["", f"Failing seeds: {seeds}."]
     return "\n".join(lines) + "\n"
+
+
+def render(data: dict[str, Any]) -> str:
+    """The page fragment: scenes fuzzed and violations per kind."""
+    a, b = data["seeds"]
+    what = "every query type" if data["swept"] else "every query type but the swept partial ones"
+    return summary(
+        data,
+        f"Seeds {a}-{b}: {data['valid']} valid scenes of {data['scenes']}, {what}, each scene "
+        f"in four frames; {data['seconds']:.0f} s with {data['jobs']} processes.",
+    )
 
 
 if __name__ == "__main__":  # pragma: no cover
