@@ -21,6 +21,8 @@ polygon gives the paper's *visibility polygons*; with aim uncertainty
 
 from __future__ import annotations
 
+import weakref
+from collections import OrderedDict
 from collections.abc import Callable
 from typing import TYPE_CHECKING
 
@@ -207,20 +209,31 @@ def _swept_region(
     stand_in = None if is_star_shaped(target) else hull_target(target, strips, region)
     if stand_in is not None:
         target, strips = stand_in.ring, stand_in.strips
-    shadows, stats = swept_shadows(
-        scene_domain(scene),
-        scene.free_space,
-        target,
-        region,
-        strips=strips,
-        eps_aim=eps_aim,
-        tol=tol,
-        deadline=budget.deadline,
-        progress=budget.report if budget.progress is not None else None,
-        what=budget.what,
-        samples=None if sink is None else sink.setdefault("samples", []),
-        extra_samples=extra_samples,
-    )
+    reuse = sink is None and extra_samples == 0 and budget.progress is None
+    key = _sweep_key(scene, target, region, strips, eps_aim, tol) if reuse else None
+    got = _SWEEPS.get(key) if key is not None else None
+    if got is not None and got[0]() is scene:
+        _SWEEPS.move_to_end(key)
+        shadows, stats = got[1]
+    else:
+        shadows, stats = swept_shadows(
+            scene_domain(scene),
+            scene.free_space,
+            target,
+            region,
+            strips=strips,
+            eps_aim=eps_aim,
+            tol=tol,
+            deadline=budget.deadline,
+            progress=budget.report if budget.progress is not None else None,
+            what=budget.what,
+            samples=None if sink is None else sink.setdefault("samples", []),
+            extra_samples=extra_samples,
+        )
+        if key is not None:
+            _SWEEPS[key] = (weakref.ref(scene), (shadows, stats))
+            while len(_SWEEPS) > SWEEPS_KEPT:
+                _SWEEPS.popitem(last=False)
     if conservative:
         # tol: the traced arcs' chords; grid: the snap-rounding of the union (sweep.py)
         shadows = disc_sum(shadows, tol + stats["grid"])
@@ -235,6 +248,37 @@ def _swept_region(
     if eps_pos > 0:
         out = shrink_for_position(out, allowed, eps_pos)
     return out
+
+
+#: How many sweeps (the union of the swept shadows, before ``conservative`` and ``eps_pos``)
+#: are kept, over all scenes, for a query that repeats one: the swept partial region with and
+#: without ``conservative=True``, or the 5.2 region and its conservative version, run the
+#: same sweeps.  A sweep is a deterministic function of its key (:func:`_sweep_key`), so a
+#: reused one is the one that would be computed.
+SWEEPS_KEPT = 16
+
+_SWEEPS: OrderedDict[tuple, tuple] = OrderedDict()
+
+
+def _sweep_key(
+    scene: Scene,
+    target: np.ndarray,
+    region: shapely.Geometry,
+    strips: list[shapely.Geometry] | None,
+    eps_aim: float,
+    tol: float,
+) -> tuple:
+    """What a sweep of ``scene`` (in its local frame) depends on; the scene by identity
+    (checked against a weak reference when the sweep is reused)."""
+    return (
+        id(scene),
+        target.shape,
+        np.ascontiguousarray(target, dtype=float).tobytes(),
+        shapely.to_wkb(region),
+        None if strips is None else tuple(shapely.to_wkb(g) for g in strips),
+        float(eps_aim),
+        float(tol),
+    )
 
 
 def swept_tol(scene: Scene, tol: float | None) -> float:

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import shapely
 
-from geometry import Scene, partial_region
+from geometry import Scene, partial_region, recognizable_region
 from geometry import sweep as S
 
 
@@ -320,3 +320,35 @@ def test_batched_weak_visibility_is_the_one_by_one_answer(monkeypatch) -> None:
             assert shapely.to_wkb(got) == shapely.to_wkb(want)
             n += 1
     assert n > 100
+
+
+def test_a_repeated_sweep_is_reused_on_the_same_scene_only(monkeypatch):
+    """The swept partial region with and without ``conservative`` and the 5.2 region after
+    it run their sweeps once per scene object (``partial._SWEEPS``); the answers equal
+    those of a freshly loaded scene, and another scene object sweeps anew."""
+    from geometry import partial as P
+
+    calls = []
+    orig = P.swept_shadows
+
+    def counted(*a, **k):
+        calls.append(1)
+        return orig(*a, **k)
+
+    monkeypatch.setattr(P, "swept_shadows", counted)
+    s = Scene.load("sensorplan_gym/scenes/lab.json")
+    a = partial_region(s, target_in="goal", theta=0.0)
+    b = partial_region(s, target_in="goal", theta=0.0, conservative=True)
+    assert len(calls) == 1
+    assert b.area < a.area and shapely.difference(b, a).area < 1e-12
+    fresh = Scene.load("sensorplan_gym/scenes/lab.json")
+    assert shapely.to_wkb(partial_region(fresh, target_in="goal", theta=0.0)) == shapely.to_wkb(a)
+    assert len(calls) == 2  # another scene object: no reuse
+    c = recognizable_region(s, model="partial", theta=0.0)
+    d = recognizable_region(s, model="partial", theta=0.0, conservative=True)
+    assert len(calls) == 4  # the 5.2 sweeps of G and H, each once
+    assert shapely.difference(d, c).area < 1e-12
+    # a progress callback sees every edge swept: no reuse then
+    seen = []
+    partial_region(s, target_in="goal", theta=0.0, progress=lambda i, n: seen.append(i))
+    assert len(calls) == 5 and seen
