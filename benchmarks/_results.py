@@ -37,6 +37,7 @@ NAMES = (
     "envs",
     "family_breakdown",
     "fuzz_contacts",
+    "fuzz_swept",
     "oracle",
     "policies",
     "pool_build",
