@@ -304,7 +304,8 @@ class Sweeper:
         vs = [
             v
             for ring in _rings(shapely.orient_polygons(shadow, exterior_cw=False))
-            if len(v := _drop_short(np.asarray(ring.coords)[:-1, :2], self.tol_lab)) >= 3
+            if len(v := _drop_short(np.asarray(ring.coords)[:-1, :2], self.tol_lab, self._vertex_at))
+            >= 3
         ]
         if not vs:
             return out
@@ -402,7 +403,23 @@ class Sweeper:
         ids = tid[perm]
         pair = np.sort(np.stack([ids[a], ids[b]], axis=1), axis=1)
         keys[rows[ok]] = pair[ok]
+        # an edge too short for two anchors "far" apart whose ends are two vertices of
+        # the environment lies on their line (a short edge that _drop_short kept)
+        short = np.flatnonzero((keys[:, 0] < 0) & (np.abs(d).max(axis=1) <= self.tol_lab))
+        if len(short):
+            ends = np.stack([v[short], v[short] + d[short]], axis=1).reshape(-1, 2)
+            at = self._vertex_at(ends).reshape(-1, 2)
+            both = (at >= 0).all(axis=1) & (at[:, 0] != at[:, 1])
+            keys[short[both]] = np.sort(at[both], axis=1)
         return keys
+
+    def _vertex_at(self, pts: np.ndarray) -> np.ndarray:
+        """Per point of ``pts`` (k, 2): the index of an environment vertex within the
+        union's snap grid of it (max-norm), or -1."""
+        vert = self.env.vert
+        near = np.abs(vert[None, :, :] - pts[:, None, :]).max(axis=2) <= self.grid
+        return np.where(near.any(axis=1), np.argmax(near, axis=1), -1)
+
 
     # -------------------------------------------------------------- point test
     def blind(self, p: np.ndarray, q: np.ndarray) -> np.ndarray:
@@ -1417,12 +1434,15 @@ def _rings(g: shapely.Geometry) -> list:
     return out
 
 
-def _drop_short(v: np.ndarray, length: float) -> np.ndarray:
+def _drop_short(
+    v: np.ndarray, length: float, vertex_at: Callable[[np.ndarray], np.ndarray] | None = None
+) -> np.ndarray:
     """The closed ring ``v`` (n, 2) without the vertices that end an edge shorter than
     ``length`` (scene units): such an edge is a corner split by the overlay's rounding
     (snap-rounding nodes a corner at a hot pixel, floating overlay leaves ulp-sized
     edges), and its line is not determined to within ``length``, so it cannot be
-    labelled and would hide its neighbours from the tracing."""
+    labelled and would hide its neighbours from the tracing.  ``vertex_at``: per point
+    of some (k, 2), the environment vertex it is at, or -1 (see :func:`_corners`)."""
     if len(v) == 0:
         return v
     step = np.abs(np.diff(v, axis=0)).max(axis=1) >= length
@@ -1442,10 +1462,16 @@ def _drop_short(v: np.ndarray, length: float) -> np.ndarray:
         tail = keep.pop()
     if len(keep) == len(v):
         return v
-    return _corners(v, keep, tail, length)
+    return _corners(v, keep, tail, length, vertex_at)
 
 
-def _corners(v: np.ndarray, keep: list, tail: int, length: float) -> np.ndarray:
+def _corners(
+    v: np.ndarray,
+    keep: list,
+    tail: int,
+    length: float,
+    vertex_at: Callable[[np.ndarray], np.ndarray] | None = None,
+) -> np.ndarray:
     """The kept vertices of :func:`_drop_short`, each moved to the corner of its cluster
     (itself and the vertices dropped after it, ``tail ..`` joining vertex 0): where the
     line of the edge entering the cluster meets that of the edge leaving it, when those
@@ -1453,26 +1479,42 @@ def _corners(v: np.ndarray, keep: list, tail: int, length: float) -> np.ndarray:
     vertex instead left a ring whose edge from it is off its own line by the split (fuzz
     seed 203978: 6e-9 of 8.6e-9 allowed), so the edge got no label, its neighbour was
     dropped as unlabelled, and that shadow edge was traced in one frame and not in
-    another."""
+    another.
+
+    Where the two lines do not cross that close, the cluster is no split corner but a
+    short edge of its own; when the cluster holds two distinct vertices of the
+    environment (``vertex_at``; a sliver obstacle's end 1.2e-8 across, fuzz seed 208530)
+    the first and the last of them are kept: the edge between lies on their line
+    (:meth:`Sweeper._label` labels it by them), and either one alone would leave the edge
+    on its other side off its line by the short edge's length, unlabelled, and its
+    moving neighbour dropped from the tracing."""
     n = len(v)
-    out = v[keep].copy()
+    out: list[np.ndarray] = []
     ends = keep[1:] + [tail]
     for j, (k, nxt) in enumerate(zip(keep, ends, strict=True)):
         first = tail % n if j == 0 and tail < n else k  # the cluster's first vertex
         last = nxt - 1  # and its last
+        out.append(v[k])
         if first == last:
             continue
         a0, a1 = v[first - 1], v[first]
         b0, b1 = v[last], v[(last + 1) % n]
         da, db = a1 - a0, b1 - b0
         den = float(da[0] * db[1] - da[1] * db[0])
-        if den == 0.0:
-            continue
-        u = float((b0[0] - a0[0]) * db[1] - (b0[1] - a0[1]) * db[0]) / den
-        c = a0 + u * da
+        c = np.full(2, np.inf)
+        if den != 0.0:
+            u = float((b0[0] - a0[0]) * db[1] - (b0[1] - a0[1]) * db[0]) / den
+            c = a0 + u * da
         if np.isfinite(c).all() and np.abs(c - v[k]).max() <= 4.0 * length:
-            out[j] = c
-    return out
+            out[-1] = c
+        elif vertex_at is not None:
+            idx = np.arange(first, first + (last - first) % n + 1) % n
+            at = vertex_at(v[idx])
+            env = np.flatnonzero(at >= 0)
+            if len(env) and (at[env] != at[env[0]]).any():
+                out[-1] = v[idx[env[0]]]
+                out.append(v[idx[env[at[env] != at[env[0]]][-1]]])
+    return np.asarray(out)
 
 
 def _rot(v: np.ndarray) -> np.ndarray:

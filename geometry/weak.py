@@ -12,7 +12,7 @@ import numpy as np
 import shapely
 
 from . import visindex as _visindex
-from ._shapes import cross, union_all
+from ._shapes import SNAP_REL, cross, union_all
 from ._vis import TAU, Domain, Gaps, RingSet, clean_polygon, gaps_many, gaps_many_rings
 from .scene import NEAR_REL
 
@@ -97,7 +97,7 @@ def weak_visibility(
     fans = list(arr[thick])
     if not fans:
         return shapely.Polygon()
-    return _union(fans, n_first=n_direct)
+    return _union(fans, n_first=n_direct, grid=SNAP_REL * dom.scale)
 
 
 def _target_anchors(
@@ -431,17 +431,25 @@ def _feet(seg: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return foot, np.hypot(*(p[:, None, :] - foot).transpose(2, 0, 1))
 
 
-def _union(polys: list[shapely.Geometry], n_first: int) -> shapely.Geometry:
+def _union(polys: list[shapely.Geometry], n_first: int, grid: float) -> shapely.Geometry:
     """Union of polygons; the later ones are first tested (vectorised) against the
-    union of the first ``n_first`` and dropped when already covered by it."""
-    first = union_all(polys[:n_first]) if n_first else shapely.Polygon()
+    union of the first ``n_first`` and dropped when already covered by it.
+
+    Snap-rounded on ``grid``: GEOS's floating overlay can fill a pocket that no fan
+    covers when a fan's edge runs within rounding of a hole's edge of the union so far
+    (fuzz seed 205614, a hole of 1e-3 D^2 closed in the frame scaled by 1e-3); the
+    snap-rounding overlay is robust by construction and moves no vertex by more than
+    half the grid.  Normalized (GEOS's normal form): the snap-rounded union's ring order
+    depends on the order of its inputs, which the batched and the one-by-one fans do not
+    share (:func:`weak_visibility_many` gives the same answer bit for bit)."""
+    first = union_all(polys[:n_first], grid_size=grid) if n_first else shapely.Polygon()
     rest = np.asarray(polys[n_first:], dtype=object)
     if len(rest) and not first.is_empty:
         shapely.prepare(first)
         rest = rest[~shapely.covers(first, rest)]
     if len(rest) == 0:
-        return first
-    return union_all(np.concatenate([[first], rest]))
+        return shapely.normalize(first)
+    return shapely.normalize(union_all(np.concatenate([[first], rest]), grid_size=grid))
 
 
 def _runs(g: Gaps, mask: np.ndarray) -> list[np.ndarray]:
@@ -627,7 +635,8 @@ def weak_visibility_many(
         thick = shapely.area(arr) > CONTACT_REL * dom.scale * shapely.length(arr)
         nd = int(thick[: n_direct[r]].sum())
         kept = list(arr[thick])
-        out.append(_union(kept, n_first=nd) if kept else shapely.Polygon())
+        grid = SNAP_REL * dom.scale
+        out.append(_union(kept, n_first=nd, grid=grid) if kept else shapely.Polygon())
     return out
 
 
