@@ -301,12 +301,11 @@ class Sweeper:
         key a pair of anchor ids spanning the line (shadow on the edge's left)."""
         out = []
         n = self.n_fixed
-        vs = [
-            v
+        short = [
+            _drop_short(np.asarray(ring.coords)[:-1, :2], self.tol_lab, self._vertex_at)
             for ring in _rings(shapely.orient_polygons(shadow, exterior_cw=False))
-            if len(v := _drop_short(np.asarray(ring.coords)[:-1, :2], self.tol_lab, self._vertex_at))
-            >= 3
         ]
+        vs = [v for v in short if len(v) >= 3]
         if not vs:
             return out
         # all rings labelled in one batch (row by row, so as if ring by ring)
@@ -419,7 +418,6 @@ class Sweeper:
         vert = self.env.vert
         near = np.abs(vert[None, :, :] - pts[:, None, :]).max(axis=2) <= self.grid
         return np.where(near.any(axis=1), np.argmax(near, axis=1), -1)
-
 
     # -------------------------------------------------------------- point test
     def blind(self, p: np.ndarray, q: np.ndarray) -> np.ndarray:
