@@ -427,6 +427,16 @@ BLIND_5_2 = [
     (208530, (5.335013768959447, 3.6823418261296497), (0, 0.405), None),
     (208530, (5.84281516845928, 4.408676473092984), (0, 0.18), None),
     (208530, (4.834832779045912, 2.9410605198832207), (0, 0.595), None),
+    # open: found by the run of the final code (frame scaled by 1e3, 7.4e-4 D^2); the frame
+    # scaled by 1e3 sampled H's edge 2 at t = 0.75 and excludes the placement, the base frame
+    # (and the code before, in every frame) traced no shadow over it: a miss of the tracing
+    pytest.param(
+        205296,
+        (0.8139447881621503, 0.178381998651345),
+        (2, 0.75),
+        None,
+        marks=pytest.mark.xfail(strict=True, reason="open: a shadow the base frame's sweep misses"),
+    ),
 ]
 
 
