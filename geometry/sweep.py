@@ -301,11 +301,11 @@ class Sweeper:
         key a pair of anchor ids spanning the line (shadow on the edge's left)."""
         out = []
         n = self.n_fixed
-        short = [
+        merged = [
             _drop_short(np.asarray(ring.coords)[:-1, :2], self.tol_lab, self._vertex_at)
             for ring in _rings(shapely.orient_polygons(shadow, exterior_cw=False))
         ]
-        vs = [v for v in short if len(v) >= 3]
+        vs = [v for v in merged if len(v) >= 3]
         if not vs:
             return out
         # all rings labelled in one batch (row by row, so as if ring by ring)

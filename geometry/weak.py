@@ -441,7 +441,8 @@ def _union(polys: list[shapely.Geometry], n_first: int, grid: float) -> shapely.
     snap-rounding overlay is robust by construction and moves no vertex by more than
     half the grid.  Normalized (GEOS's normal form): the snap-rounded union's ring order
     depends on the order of its inputs, which the batched and the one-by-one fans do not
-    share (:func:`weak_visibility_many` gives the same answer bit for bit)."""
+    share (:func:`weak_visibility_many` gives the same coordinates in the same order; the
+    rounding can give -0.0 in one where the other has 0.0)."""
     first = union_all(polys[:n_first], grid_size=grid) if n_first else shapely.Polygon()
     rest = np.asarray(polys[n_first:], dtype=object)
     if len(rest) and not first.is_empty:
