@@ -382,26 +382,39 @@ class Sweeper:
         )
         keys = np.full((len(v), 2), -1, dtype=np.int64)
         # two distinct positions on the line; prefer fixed anchors, then moving ones (in
-        # table order): the first candidate in that order, then the first one away from it
+        # table order): the first pair (i, j), i before j in that order, of candidates
+        # more than tol_lab apart whose line is the edge's.  Two anchors barely "far"
+        # apart (the two vertices at a sliver's end, 1e-8 across) both lie on the edge's
+        # line, but the line they span points anywhere: the edge's ends must lie on it
+        # (fuzz seed 205296: a sliver's shadow edges were keyed to the sliver's ends,
+        # read as fixed, and never traced)
         perm = np.argsort(tid >= self.n_fixed, kind="stable")
         on = (dist <= self.tol_lab)[:, perm]
-        rows = np.flatnonzero(on.any(axis=1))
-        if len(rows) == 0:
-            return keys
-        on = on[rows]
-        tab = table[perm]
-        a = np.argmax(on, axis=1)
-        # the candidates are few per row: test "away from the first" on them only
         r_on, c_on = np.nonzero(on)  # row-major: by row, then in perm order
-        far = np.abs(tab[c_on] - tab[a[r_on]]).max(axis=1) > self.tol_lab
-        r_far, first = np.unique(r_on[far], return_index=True)
-        ok = np.zeros(len(rows), dtype=bool)
-        ok[r_far] = True
-        b = np.zeros(len(rows), dtype=np.int64)
-        b[r_far] = c_on[far][first]
+        if len(r_on) == 0:
+            return keys
+        tab = table[perm]
+        # the candidates are few per row: their pairs (i, j), i < j, in one row
+        cnt = np.bincount(r_on, minlength=len(v))
+        pi, pj = [], []
+        for s in range(1, int(cnt.max())):
+            k = np.flatnonzero(r_on[:-s] == r_on[s:])
+            pi.append(k)
+            pj.append(k + s)
+        if not pi:
+            return keys
+        pi, pj = np.concatenate(pi), np.concatenate(pj)
+        ci, cj = c_on[pi], c_on[pj]
+        good = np.abs(tab[cj] - tab[ci]).max(axis=1) > self.tol_lab
+        rr = r_on[pi]
+        good[good] = self._fits(tab[ci[good]], tab[cj[good]], v[rr[good]], d[rr[good]])
+        pi, pj, rr = pi[good], pj[good], rr[good]
+        order = np.lexsort((pj, pi))  # the first pair of each row
+        rr_s = rr[order]
+        r_first, first = np.unique(rr_s, return_index=True)
         ids = tid[perm]
-        pair = np.sort(np.stack([ids[a], ids[b]], axis=1), axis=1)
-        keys[rows[ok]] = pair[ok]
+        sel = order[first]
+        keys[r_first] = np.sort(np.stack([ids[c_on[pi[sel]]], ids[c_on[pj[sel]]]], axis=1), axis=1)
         # an edge too short for two anchors "far" apart whose ends are two vertices of
         # the environment lies on their line (a short edge that _drop_short kept)
         short = np.flatnonzero((keys[:, 0] < 0) & (np.abs(d).max(axis=1) <= self.tol_lab))
@@ -411,6 +424,15 @@ class Sweeper:
             both = (at >= 0).all(axis=1) & (at[:, 0] != at[:, 1])
             keys[short[both]] = np.sort(at[both], axis=1)
         return keys
+
+    def _fits(self, a: np.ndarray, b: np.ndarray, v: np.ndarray, d: np.ndarray) -> np.ndarray:
+        """Row by row: do both ends of the edge ``v -> v + d`` lie within ``tol_lab`` of
+        the line through the anchors ``a`` and ``b`` (all (k, 2))?  (k,) bool."""
+        w = b - a
+        ln = np.maximum(np.hypot(w[:, 0], w[:, 1]), 1e-300)
+        d0 = np.abs(_cross(w, v - a)) / ln
+        d1 = np.abs(_cross(w, v + d - a)) / ln
+        return np.maximum(d0, d1) <= self.tol_lab
 
     def _vertex_at(self, pts: np.ndarray) -> np.ndarray:
         """Per point of ``pts`` (k, 2): the index of an environment vertex within the

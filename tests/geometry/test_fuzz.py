@@ -299,6 +299,8 @@ def _swept_frame_diff(seed: int, query: str, frame: str) -> float:
 #: 1e-8 in each coordinate) merged into one corner: the next shadow edge was off its line
 #: by the sliver's width, unlabelled, and its neighbour not traced; the frames differed by
 #: up to 1.7e-4 D^2, and the scaled frames held placements blind at H (``BLIND_5_2``).
+#: 205296 (seeds 200000-206949) -- a sliver's shadow edges keyed to the sliver's two end
+#: vertices, 1.2e-8 apart, whose line is not the edge's (``BLIND_5_2``).
 SWEPT_FRAME_SEEDS = [
     (200033, "recognizable 5.2", "scale1e-3"),
     (200323, "partial in", "scale1e-3"),
@@ -312,6 +314,7 @@ SWEPT_FRAME_SEEDS = [
     (203978, "recognizable 5.2", "utm"),
     (208530, "recognizable 5.2", "scale1e-3"),
     (208530, "recognizable 5.2", "utm"),
+    (205296, "recognizable 5.2", "scale1e3"),
 ]
 
 
@@ -398,6 +401,40 @@ def test_short_edge_between_environment_vertices_is_kept():
     assert len(got) == 5 and {tuple(x) for x in got} >= {tuple(x) for x in ring[[0, 1, 3, 4]]}
 
 
+def test_label_wants_the_edge_on_the_pair_line():
+    """Two environment vertices 1.2e-8 apart (a sliver's end) both lie within the label
+    tolerance of a long shadow edge through one of them, but the line they span is not the
+    edge's: the edge is keyed by a vertex and the moving anchor on its line (fuzz seed
+    205296, where such edges were read as fixed and never traced)."""
+    import numpy as np
+
+    from geometry.sweep import Sweeper
+
+    end = np.array([0.393986, -0.368987])
+    far = np.array([0.399168, -1.0])  # the edge runs from ``far`` to ``end``
+    u = (end - far) / np.hypot(*(end - far))
+    n = np.array([-u[1], u[0]])
+    twin = end + 0.9e-8 * n + 0.8e-8 * u  # 1.2e-8 away, 0.9e-8 off the line
+    moving = end + 0.3 * u  # a target vertex on the edge's line
+    table = np.array([[0.0, 0.0], end, twin, [1.0, 0.0], moving])
+    tid = np.array([0, 1, 2, 3, 7])
+
+    class Fake:
+        tol_lab = 1e-8
+        n_fixed = 4
+        _fits = Sweeper._fits
+
+        def _vertex_at(self, pts):
+            return np.full(len(pts), -1)
+
+    keys = Sweeper._label(Fake(), far[None], table, tid, d=(end - far)[None])
+    assert keys.tolist() == [[1, 7]]
+    # a pair that does span the edge's line keeps the preference for fixed anchors
+    table[3] = end - 0.5 * u
+    keys = Sweeper._label(Fake(), far[None], table, tid, d=(end - far)[None])
+    assert keys.tolist() == [[1, 3]]
+
+
 #: Seeds of the longer swept run (201200-204449) whose ``partial_region(target_in="goal",
 #: conservative=True)`` held placements blind at a configuration between the sweep's
 #: samples ("translating ⊆ stationary at sampled q (partial)", 3.5e-8 and 1.6e-6 D^2):
@@ -427,16 +464,12 @@ BLIND_5_2 = [
     (208530, (5.335013768959447, 3.6823418261296497), (0, 0.405), None),
     (208530, (5.84281516845928, 4.408676473092984), (0, 0.18), None),
     (208530, (4.834832779045912, 2.9410605198832207), (0, 0.595), None),
-    # open: found by the run of the final code (frame scaled by 1e3, 7.4e-4 D^2); the frame
-    # scaled by 1e3 sampled H's edge 2 at t = 0.75 and excludes the placement, the base frame
-    # (and the code before, in every frame) traced no shadow over it: a miss of the tracing
-    pytest.param(
-        205296,
-        (0.8139447881621503, 0.178381998651345),
-        (2, 0.75),
-        None,
-        marks=pytest.mark.xfail(strict=True, reason="open: a shadow the base frame's sweep misses"),
-    ),
+    # found by the run of seeds 200000-206949 (frame scaled by 1e3, 7.4e-4 D^2): the two
+    # moving edges of a sliver's shadow were keyed to the sliver's ends (two vertices
+    # 1.2e-8 apart, both on each edge's line) and read as fixed, so they were never traced;
+    # the frame scaled by 1e3 happened to sample H's edge 2 inside the 6 % of it where this
+    # placement is blind (``Sweeper._label`` now wants the edge on the pair's line)
+    (205296, (0.8139447881621503, 0.178381998651345), (2, 0.75), None),
 ]
 
 
