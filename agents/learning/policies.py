@@ -229,6 +229,7 @@ OBSERVATION_KWARGS = (
     "placement_aims",
     "self_features",
     "aim_features",
+    "grid_views",
 )
 
 
@@ -258,16 +259,27 @@ def policy_label(spec: str) -> str:
 
 
 def model_path(spec: str | Path) -> Path:
-    """The model zip a policy spec names (``path/model`` also finds ``path/model.zip``).
-    Raises ``FileNotFoundError`` naming the spec when there is no such file."""
+    """The model file a policy spec names: an SB3 zip, or a pixel policy's ``.pt``
+    (:mod:`agents.learning.pixel_bc`); ``path/model`` also finds ``path/model.zip`` and then
+    ``path/model.pt``.  Raises ``FileNotFoundError`` naming the spec when there is no such
+    file."""
     path = Path(spec).expanduser()
-    if path.suffix != ".zip" and not path.exists() and path.with_suffix(".zip").exists():
-        path = path.with_suffix(".zip")
+    if path.suffix not in (".zip", ".pt") and not path.exists():
+        for suffix in (".zip", ".pt"):
+            if path.with_suffix(suffix).exists():
+                path = path.with_suffix(suffix)
+                break
     if not path.is_file():
         raise FileNotFoundError(
-            f"policy {str(spec)!r} is neither 'oracle', 'random' nor an existing model zip"
+            f"policy {str(spec)!r} is neither 'oracle', 'random' nor an existing model zip "
+            "or pixel policy (.pt)"
         )
     return path
+
+
+def _is_pixel_policy(path: Path) -> bool:
+    """A ``.pt`` file whose config beside it says ``algo: pixel_bc``."""
+    return path.suffix == ".pt" and (model_config(path) or {}).get("algo") == "pixel_bc"
 
 
 def check_policies(specs: list[str]) -> None:
@@ -285,6 +297,17 @@ def check_policies(specs: list[str]) -> None:
             path = model_path(spec)
         except FileNotFoundError as e:
             missing.append(str(e))
+            continue
+        if path.suffix == ".pt":
+            try:
+                pixel = _is_pixel_policy(path)
+            except ImportError:  # no yaml (rl extra): load_policy will say so
+                continue
+            if not pixel:
+                bad.append(
+                    f"policy {spec!r}: {str(path)!r} has no config beside it with "
+                    "'algo: pixel_bc' (a pixel policy, agents.learning.pixel_bc)"
+                )
             continue
         if not zipfile.is_zipfile(path):
             bad.append(f"policy {spec!r}: {str(path)!r} is not a zip archive (an SB3 model)")
@@ -304,7 +327,8 @@ def check_policies(specs: list[str]) -> None:
 
 
 def load_policy(spec: str, env, *, seed: int = 0, device: str = "cpu"):
-    """A policy object for ``spec`` (``"oracle"``, ``"random"`` or a model zip), bound to
+    """A policy object for ``spec`` (``"oracle"``, ``"random"``, a model zip or a pixel
+    policy's ``.pt``), bound to
     ``env`` where that matters.  Raises ``FileNotFoundError`` for a missing zip and
     ``ValueError`` for a zip no algorithm can load."""
     if spec == "oracle":
@@ -315,6 +339,12 @@ def load_policy(spec: str, env, *, seed: int = 0, device: str = "cpu"):
         return RandomPolicy(env.action_space, seed=seed, observation_space=env.observation_space)
     path = model_path(spec)
     cfg = model_config(path) or {}
+    if path.suffix == ".pt":
+        if cfg.get("algo") != "pixel_bc":
+            raise ValueError(f"{path}: no config beside it with 'algo: pixel_bc'")
+        from .pixel_bc import PixelPolicy
+
+        return PixelPolicy.load(path)
     order = [cfg["algo"]] if cfg.get("algo") in ALGOS else list(ALGOS)
     errors = []
     model = None

@@ -16,6 +16,13 @@ batch of agent actions into those vectors.
     ``-pi + 2 pi k / A``: ``a = (i * G + j) * A + k`` for column ``i`` (x), row ``j`` (y),
     aim ``k`` (``G = 16``, ``A = 8`` by default).  A non-integer, or an integer outside
     ``[0, K)``, raises ``ValueError``.
+``"pixel"`` (Placement)
+    ``Discrete(S * S * A)``: one placement per pixel of the grid observation (its centre;
+    ``S = grid_size``, the scene's bounding box fit into the square, row 0 at the top) times
+    ``A = placement_aims`` aims ``-pi + 2 pi k / A``: ``a = (row * S + col) * A + k``, i.e.
+    ``np.unravel_index(a, (S, S, A))``, so that a fully convolutional policy's output map
+    lines up with its input.  A pixel outside the bounding box (the square's padding) is
+    placed on the box's edge.
 """
 
 from __future__ import annotations
@@ -29,11 +36,13 @@ from . import fused
 
 __all__ = ["ACTION_TYPES", "ContinuousActions", "DiscreteActions", "make_actions"]
 
-ACTION_TYPES = ("continuous", "discrete")
+ACTION_TYPES = ("continuous", "discrete", "pixel")
 
 
 class ContinuousActions:
     """The task's own ``Box(-1, 1, (d,))``."""
+
+    square = False  # x and y span the bounding box (see DiscreteActions)
 
     def __init__(self, dim: int) -> None:
         self.dim = dim
@@ -58,9 +67,13 @@ class ContinuousActions:
 
 
 class DiscreteActions:
-    """``Discrete(K)``: rows of ``table`` ``(K, d)``."""
+    """``Discrete(K)``: rows of ``table`` ``(K, d)``.  ``square``: a Placement table whose x and
+    y span the grid observation's square (``"pixel"``), not the bounding box."""
 
-    def __init__(self, table: np.ndarray, names: list[str] | None = None) -> None:
+    def __init__(
+        self, table: np.ndarray, names: list[str] | None = None, *, square: bool = False
+    ) -> None:
+        self.square = bool(square)
         self.table = np.asarray(table, dtype=np.float64)
         self.dim = self.table.shape[1]
         self.names = names
@@ -95,6 +108,19 @@ def make_actions(kind: str, task: str, dim: int, **kw: Any):
         raise ValueError(f"action_type must be one of {ACTION_TYPES}, got {kind!r}")
     if kind == "continuous":
         return ContinuousActions(dim)
+    if kind == "pixel":
+        if task != "placement":
+            raise ValueError("action_type='pixel' is Placement's (one action per grid pixel)")
+        if "placement_grid" in kw:
+            raise ValueError(
+                "action_type='pixel' takes its grid from grid_size, not placement_grid"
+            )
+        s, na = int(kw.get("grid_size", 64)), int(kw.get("placement_aims", 8))
+        if na < 1:
+            raise ValueError(f"placement_aims must be >= 1, got {na}")
+        u = -1.0 + (2 * np.arange(s) + 1) / s  # pixel centres, left to right
+        R, C, A = np.meshgrid(-u, u, -1.0 + 2 * np.arange(na) / na, indexing="ij")
+        return DiscreteActions(np.stack([C.ravel(), R.ravel(), A.ravel()], axis=1), square=True)
     if task == "placement":
         g, na = int(kw.get("placement_grid", 16)), int(kw.get("placement_aims", 8))
         if g < 1 or na < 1:

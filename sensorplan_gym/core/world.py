@@ -399,6 +399,26 @@ class World:
             self._cache[key] = out
         return self._cache[key]
 
+    def view_raster(self, size: int) -> np.ndarray:
+        """``(2, size, size)`` uint8 on :meth:`raster`'s grid: 255 where a pixel's centre lies
+        in the visibility polygon of G's / H's anchor point (the free space seen from there, the
+        raster twin of the vector observation's two scans), else 0."""
+        key = f"views{size}"
+        if key not in self._cache:
+            from geometry._vis import domain_from_geometry, visibility_polygon
+
+            scale, ox, oy = self.grid_transform(size)
+            ij = np.arange(size) + 0.5
+            X, Y = np.meshgrid(ox + ij / scale, oy + (size - ij) / scale)
+            dom = domain_from_geometry(self.free_space)
+            out = np.zeros((2, size, size), dtype=np.uint8)
+            for k, c in enumerate((self.goal_center, self.failure_center)):
+                if shapely.contains_xy(self.free_space, *c):
+                    vis = visibility_polygon(dom, np.asarray(c, dtype=np.float64))
+                    out[k] = np.where(shapely.contains_xy(vis, X, Y), 255, 0)
+            self._cache[key] = out
+        return self._cache[key]
+
     def grid_transform(self, size: int) -> tuple[float, float, float]:
         span = float(max(self.hi - self.lo))
         scale = size / span

@@ -55,7 +55,8 @@ noise : float, default 0 -- std of Gaussian range noise (scene units), truncated
 obs_type : ``"vector"`` (default) | ``"grid"`` (see :mod:`sensorplan_gym.core.observations`).
 grid_size : int, default 64 -- side of the grid observation.
 robot_radius : float, default 0 -- the robot is a disc of this radius (0: a point).
-action_type : ``"continuous"`` (default) | ``"discrete"`` (see :mod:`sensorplan_gym.core.actions`).
+action_type : ``"continuous"`` (default) | ``"discrete"`` | ``"pixel"`` (Placement: one
+    action per pixel of the grid observation and aim; see :mod:`sensorplan_gym.core.actions`).
 map_ranges : bool, default False -- Navigate/Recognize vector observations also carry, per
     beam, the range the static map predicts from the commanded pose (see
     :mod:`sensorplan_gym.core.observations`): a reading that differs reveals the target.
@@ -67,7 +68,10 @@ sensor_fov : bool, default False -- Navigate/Recognize vector observations end w
 self_features : bool, default False -- vector observations (Navigate, Recognize, Placement)
     end with what the robot knows of its own sensor: field of view / 360 degrees and reach
     (maximum range, at most the diameter) / scene diameter (for scene families whose sensors
-    differ).
+    differ); Placement's grid observation gets them as two constant channels.
+grid_views : bool, default False -- Placement's grid observation gets two more channels, the
+    free space seen from G's and from H's anchor point (the raster twin of the vector
+    observation's two scans).
 aim_features : bool, default False -- Navigate/Recognize vector observations end with the
     arcs of directions that K_G and K_H (the swept hulls) cover from the robot's pose, relative
     to its heading, and their farthest vertex's distance over the reach (see
@@ -331,6 +335,7 @@ class SensorPlanBatch(BatchSim):
         sensor_fov: bool = False,
         self_features: bool = False,
         aim_features: bool = False,
+        grid_views: bool = False,
         **action_kw: Any,
     ) -> None:
         for name, v in (
@@ -369,17 +374,27 @@ class SensorPlanBatch(BatchSim):
             ("sensor_fov", sensor_fov),
             ("self_features", self_features),
             ("aim_features", aim_features),
+            ("grid_views", grid_views),
         ):
             if not isinstance(v, bool):
                 raise ValueError(f"{name} must be True or False, got {v!r}")
+            placement = self.obs_kind == "placement"
             if (
                 not v
-                or obs_type == "vector"
-                and (self.obs_kind == "robot" or name == "self_features")
+                or name == "grid_views"
+                and placement
+                and obs_type == "grid"
+                or name != "grid_views"
+                and obs_type == "vector"
+                and (not placement or name == "self_features")
+                or name == "self_features"
+                and placement
             ):
                 continue
             raise ValueError(
-                f"{name}=True needs obs_type='vector' in Navigate or Recognize"
+                "grid_views=True needs obs_type='grid' in Placement"
+                if name == "grid_views"
+                else f"{name}=True needs obs_type='vector' in Navigate or Recognize"
                 + (" (or Placement)" if name == "self_features" else "")
             )
         self.map_ranges = map_ranges or map_evidence  # the sim computes the map's ranges
@@ -397,9 +412,12 @@ class SensorPlanBatch(BatchSim):
             sensor_fov=sensor_fov,
             self_features=self_features,
             aim_features=aim_features,
+            grid_views=grid_views,
         )
         self.single_observation_space = self.obs.space
-        self.actions = make_actions(action_type, self.action_task, self.action_dim, **action_kw)
+        self.actions = make_actions(
+            action_type, self.action_task, self.action_dim, grid_size=grid_size, **action_kw
+        )
         self.action_type = action_type
         self.single_action_space = self.actions.space
         # episodes started per sub-environment: a planner bound to the env tells a new

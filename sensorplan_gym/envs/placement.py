@@ -94,7 +94,18 @@ class PlacementBatch(SensorPlanBatch):
         }
         return reward, cols
 
+    def square_to_box(self, a: np.ndarray, idx: np.ndarray) -> np.ndarray:
+        """Actions ``(k, 3)`` whose x and y span the grid observation's square (the bounding
+        box fit into it, centred: ``action_type="pixel"``) as actions over the bounding box,
+        clipped to it."""
+        span = self.hi[idx] - self.lo[idx]
+        out = a.copy()
+        out[:, :2] = np.clip(a[:, :2] * (span.max(axis=1, keepdims=True) / span), -1.0, 1.0)
+        return out
+
     def step_envs(self, act: np.ndarray, idx: np.ndarray):
+        if self.actions.square:
+            act = self.square_to_box(act, idx)
         if self.fused:
             return self._step_compiled(act, idx)
         pose = self.action_to_pose(act, idx)
@@ -191,8 +202,10 @@ class PlacementEnv(SensorPlanEnv):
     raise ``ValueError``.  ``action_type="discrete"``: ``Discrete(G * G * A)``, a ``G x G``
     grid of placements (cell centres) times ``A`` aims ``-pi + 2 pi k / A``, ``a = (i * G +
     j) * A + k`` for column ``i`` (x), row ``j`` (y), aim ``k``; ``G = placement_grid`` (16),
-    ``A = placement_aims`` (8).  ``env.action_to_pose(a)`` / ``env.pose_to_action(pose)``
-    convert between continuous actions and poses.
+    ``A = placement_aims`` (8).  ``action_type="pixel"``: ``Discrete(S * S * A)``, one
+    placement per pixel of the grid observation (``S = grid_size``), ``a = (row * S + col) *
+    A + k`` (:mod:`sensorplan_gym.core.actions`).  ``env.action_to_pose(a)`` /
+    ``env.pose_to_action(pose)`` convert between continuous actions and poses.
 
     ## Observation Space
     ``obs_type="vector"`` (default): ``Box(float32, (8 + 2 * n,))``, ``n = n_beams``;
@@ -214,7 +227,9 @@ class PlacementEnv(SensorPlanEnv):
 
     ``obs_type="grid"``: ``Box(uint8, (3, S, S))``, ``S = grid_size`` (default 64), channel
     first, the bounding box fit into the square (aspect kept), row 0 at the top; channels
-    0 not free (walls, obstacles, outside), 1 G, 2 H.
+    0 not free (walls, obstacles, outside), 1 G, 2 H; ``grid_views=True`` adds the free space
+    seen from G's and from H's anchor, ``self_features=True`` two constant planes (field of
+    view / 360 degrees, reach / diameter, times 255).
 
     ## Rewards
     ``1`` when the commanded pose distinguishes "target in G" from "target in H" under the

@@ -162,7 +162,13 @@ def test_placement_self_features():
     with pytest.raises(ValueError, match="sensor_fov=True needs obs_type='vector' in Navigate"):
         gym.make(env_id, sensor_fov=True)
     with pytest.raises(ValueError, match=r"self_features=True needs .* \(or Placement\)"):
-        gym.make(env_id, self_features=True, obs_type="grid")
+        gym.make(NAV, self_features=True, obs_type="grid")
+    # Placement's grid observation carries them as two constant planes (times 255)
+    grid = gym.make(env_id, self_features=True, obs_type="grid", **kw)
+    obs, _ = grid.reset(seed=0)
+    scene = grid.unwrapped.world.scene
+    assert obs.shape[0] == 5 and (obs[3] == obs[3, 0, 0]).all()
+    assert obs[3, 0, 0] == round(255 * min(scene.sensor.fov_deg / 360.0, 1.0))
 
 
 def test_default_observation_shapes_are_unchanged():

@@ -1,0 +1,309 @@
+"""Placement learned from the exact answer, pixel by pixel: a fully convolutional policy.
+
+``python -m agents.learning.pixel_bc [--difficulty hard] [--pool-size 2048] [--epochs 40]
+[--seed 0] [--out DIR]``
+
+Placement-v0 is a contextual bandit: one decision per scene, and the exact geometry says, for
+every candidate pose, whether it tells G from H.  So the teacher here is not one expert action
+(the oracle's, which a regression averages over the many right answers: issue 22's BC on
+continuous actions reached 0.10) but the whole *set* of right actions of each training scene:
+
+* the env is ``sensorplan/Placement-v0`` with ``obs_type="grid"``, ``grid_views=True``,
+  ``self_features=True`` (channels: not free, G, H, the free space seen from G's and H's
+  anchors, field of view and reach planes) and ``action_type="pixel"`` (one action per
+  pixel and aim, :mod:`sensorplan_gym.core.actions`), so that an output map lines up with
+  the input map;
+* :func:`valid_actions` labels every pixel action of a scene by the env's own exact reward
+  (the recognizable region's ``contains_xy`` and the aim test, :meth:`PlacementBatch.evaluate`);
+* :class:`PixelNet` maps the observation to one logit per action (dilated residual
+  convolutions with coordinate channels; receptive field wider than the grid);
+* :func:`fit` maximises the log-probability of the *set* of valid actions, ``log sum_{a
+  valid} softmax(logits)_a`` (the likelihood of "some right answer", which does not average
+  modes), over the scenes of a training pool with the eight symmetries of the square (a
+  quarter turn shifts the aims by ``A / 4``, a mirror maps aim ``k`` to ``A / 2 - k``);
+* :class:`PixelPolicy` plays the arg-max action; it has SB3's ``predict`` signature, and
+  ``sensorplan evaluate`` / ``benchmark`` load it from its ``.pt`` file and the resolved config
+  beside it (``algo: pixel_bc``).
+
+Frames and units: observations and actions are the env's (:mod:`sensorplan_gym.envs.placement`).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import torch
+import yaml
+from torch import nn
+
+__all__ = ["ENV_ID", "ENV_KWARGS", "PixelNet", "PixelPolicy", "fit", "scene_data", "valid_actions"]
+
+ENV_ID = "sensorplan/Placement-v0"
+
+#: The observation and action kwargs of the pixel policy (the scene kwargs are the caller's).
+ENV_KWARGS: dict[str, Any] = {
+    "obs_type": "grid",
+    "grid_views": True,
+    "self_features": True,
+    "action_type": "pixel",
+    "grid_size": 64,
+    "placement_aims": 16,
+}
+
+
+def valid_actions(batch, i: int = 0) -> np.ndarray:
+    """``(S, S, A)`` bool: which pixel actions earn reward 1 in sub-environment ``i`` of the
+    Placement batch ``batch`` (made with ``action_type="pixel"``), by the env's exact test."""
+    tab = batch.actions.table
+    idx = np.full(len(tab), i, dtype=np.int64)
+    pose = batch.action_to_pose(batch.square_to_box(tab, idx), idx)
+    reward, _ = batch.evaluate(pose, idx)
+    s = batch.obs.size
+    return (reward > 0.5).reshape(s, s, -1)
+
+
+def scene_data(
+    env_kwargs: dict[str, Any], *, jobs: int | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """Observations ``(N, C, S, S)`` uint8 and valid-action masks ``(N, S, S, A)`` of every
+    scene of the pool that ``env_kwargs`` (``scene="random"``, its pool kwargs, and
+    :data:`ENV_KWARGS`) describes, or of its one scene."""
+    from sensorplan_gym.envs.placement import PlacementBatch
+
+    kw = {**env_kwargs, **ENV_KWARGS}
+    if jobs is not None and kw.get("scene") == "random":
+        kw["scene_pool_jobs"] = jobs
+    batch = PlacementBatch(1, **kw)
+    random = kw.get("scene") == "random"
+    worlds = (
+        (batch.source.get(k)[0] for k in range(int(kw.get("scene_pool_size", 64))))
+        if random
+        else [batch.source.world]
+    )
+    obs, masks = [], []
+    for world in worlds:
+        batch.load_world(0, world)
+        obs.append(batch.obs.of_world(world))
+        masks.append(valid_actions(batch, 0))
+    return np.stack(obs), np.stack(masks)
+
+
+class _Block(nn.Module):
+    def __init__(self, ch: int, dilation: int) -> None:
+        super().__init__()
+        self.conv1 = nn.Conv2d(ch, ch, 3, padding=dilation, dilation=dilation)
+        self.conv2 = nn.Conv2d(ch, ch, 3, padding=1)
+        self.norm = nn.GroupNorm(8, ch)
+
+    def forward(self, x: torch.Tensor) -> torch.Tensor:
+        return x + self.conv2(torch.relu(self.norm(self.conv1(torch.relu(x)))))
+
+
+class PixelNet(nn.Module):
+    """Observation ``(B, C, S, S)`` (uint8 scale) -> logits ``(B, S * S * A)`` in the pixel
+    action order ``(row, col, aim)``."""
+
+    def __init__(
+        self,
+        channels: int,
+        aims: int,
+        width: int = 48,
+        dilations: tuple[int, ...] = (1, 2, 4, 8, 16, 1),
+    ) -> None:
+        super().__init__()
+        self.aims = int(aims)
+        self.stem = nn.Conv2d(channels + 2, width, 3, padding=1)
+        self.blocks = nn.Sequential(*[_Block(width, d) for d in dilations])
+        self.head = nn.Conv2d(width, self.aims, 1)
+
+    def forward(self, obs: torch.Tensor) -> torch.Tensor:
+        x = obs.float() / 255.0
+        b, _, h, w = x.shape
+        ys = torch.linspace(-1.0, 1.0, h, device=x.device).view(1, 1, h, 1).expand(b, 1, h, w)
+        xs = torch.linspace(-1.0, 1.0, w, device=x.device).view(1, 1, 1, w).expand(b, 1, h, w)
+        x = self.blocks(self.stem(torch.cat([x, ys, xs], dim=1)))
+        return self.head(torch.relu(x)).permute(0, 2, 3, 1).reshape(b, -1)  # (B, S*S*A)
+
+
+def _augment(
+    obs: np.ndarray, mask: np.ndarray, k: int, flip: bool
+) -> tuple[np.ndarray, np.ndarray]:
+    """The scene turned ``k`` quarter turns counter-clockwise, then mirrored left-right if
+    ``flip``: observation ``(C, S, S)`` and mask ``(S, S, A)`` alike (aims follow)."""
+    a = mask.shape[-1]
+    o = np.rot90(obs, k, axes=(1, 2))
+    m = np.roll(np.rot90(mask, k, axes=(0, 1)), k * a // 4, axis=2)
+    if flip:
+        o = o[:, :, ::-1]
+        m = m[:, ::-1, (a // 2 - np.arange(a)) % a]
+    return np.ascontiguousarray(o), np.ascontiguousarray(m)
+
+
+def set_nll(logits: torch.Tensor, valid: torch.Tensor) -> torch.Tensor:
+    """Mean over the batch of ``-log sum_{a valid} softmax(logits)_a`` (rows with no valid
+    action must be left out by the caller)."""
+    logp = torch.log_softmax(logits, dim=1)
+    return -(torch.logsumexp(logp.masked_fill(~valid, -torch.inf), dim=1)).mean()
+
+
+def fit(
+    obs: np.ndarray,
+    masks: np.ndarray,
+    *,
+    epochs: int = 40,
+    batch_size: int = 32,
+    lr: float = 2e-3,
+    seed: int = 0,
+    width: int = 48,
+    augment: bool = True,
+    log: Any = print,
+) -> PixelNet:
+    """A :class:`PixelNet` trained on the scenes ``obs`` ``(N, C, S, S)`` with valid-action
+    masks ``masks`` ``(N, S, S, A)`` (scenes with no valid action are skipped): Adam with a
+    cosine schedule, the set likelihood :func:`set_nll`, a random symmetry of the square per
+    sample and epoch when ``augment``."""
+    torch.manual_seed(seed)
+    rng = np.random.default_rng(seed)
+    keep = masks.reshape(len(masks), -1).any(axis=1)
+    obs, masks = obs[keep], masks[keep]
+    net = PixelNet(obs.shape[1], masks.shape[-1], width=width)
+    opt = torch.optim.Adam(net.parameters(), lr=lr)
+    steps = epochs * max(1, -(-len(obs) // batch_size))
+    sched = torch.optim.lr_scheduler.CosineAnnealingLR(opt, steps)
+    for ep in range(epochs):
+        order = rng.permutation(len(obs))
+        total = 0.0
+        for s in range(0, len(order), batch_size):
+            rows = order[s : s + batch_size]
+            if augment:
+                pairs = [
+                    _augment(obs[r], masks[r], int(rng.integers(4)), bool(rng.integers(2)))
+                    for r in rows
+                ]
+                o = np.stack([p[0] for p in pairs])
+                m = np.stack([p[1] for p in pairs])
+            else:
+                o, m = obs[rows], masks[rows]
+            loss = set_nll(net(torch.from_numpy(o)), torch.from_numpy(m.reshape(len(rows), -1)))
+            opt.zero_grad()
+            loss.backward()
+            opt.step()
+            sched.step()
+            total += float(loss.detach()) * len(rows)
+        if log is not None:
+            log(f"epoch {ep + 1}/{epochs}: set NLL {total / len(obs):.3f}")
+    net.eval()
+    return net
+
+
+class PixelPolicy:
+    """The arg-max action of a :class:`PixelNet` (SB3's ``predict`` signature)."""
+
+    def __init__(self, net: PixelNet) -> None:
+        self.net = net.eval()
+
+    def predict(
+        self,
+        observation: np.ndarray,
+        state: Any = None,
+        episode_start: Any = None,
+        deterministic: bool = True,
+    ) -> tuple[np.ndarray, Any]:
+        """Actions (ints) for one observation ``(C, S, S)`` or a batch ``(B, C, S, S)``."""
+        obs = np.asarray(observation)
+        one = obs.ndim == 3
+        with torch.no_grad():
+            logits = self.net(torch.from_numpy(obs[None] if one else obs))
+        if deterministic:
+            act = logits.argmax(dim=1)
+        else:
+            act = torch.distributions.Categorical(logits=logits).sample()
+        out = act.numpy().astype(np.int64)
+        return (out[0] if one else out), state
+
+    def save(self, path: str | Path, config: dict[str, Any]) -> Path:
+        """Write the weights to ``path`` (``.pt``) and ``config`` (with the net's shape) beside
+        it (``.yaml``); returns the ``.pt`` path."""
+        path = Path(path).with_suffix(".pt")
+        path.parent.mkdir(parents=True, exist_ok=True)
+        head = self.net.head
+        shape = {
+            "channels": int(self.net.stem.in_channels - 2),
+            "aims": int(head.out_channels),
+            "width": int(head.in_channels),
+        }
+        torch.save({"state_dict": self.net.state_dict(), "shape": shape}, path)
+        with open(path.with_suffix(".yaml"), "w") as f:
+            yaml.safe_dump({**config, "algo": "pixel_bc", "net": shape}, f, sort_keys=False)
+        return path
+
+    @classmethod
+    def load(cls, path: str | Path) -> PixelPolicy:
+        """The policy saved by :meth:`save` at ``path``."""
+        got = torch.load(Path(path), map_location="cpu", weights_only=True)
+        shape = got["shape"]
+        net = PixelNet(shape["channels"], shape["aims"], width=shape["width"])
+        net.load_state_dict(got["state_dict"])
+        return cls(net)
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(
+        prog="python -m agents.learning.pixel_bc", description=__doc__.split("\n")[0]
+    )
+    p.add_argument("--difficulty", default="hard", help="the scene family's level")
+    p.add_argument("--pool-size", type=int, default=2048, help="training scenes")
+    p.add_argument(
+        "--pool-seed",
+        type=int,
+        default=0,
+        help="the pool's seed (0: the benchmark's train)",
+    )
+    p.add_argument("--epochs", type=int, default=40)
+    p.add_argument("--width", type=int, default=48)
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--jobs", type=int, default=None, help="processes that build the pool")
+    p.add_argument("--threads", type=int, default=None, help="torch threads")
+    p.add_argument("--out", default="runs/pixel_bc", help="folder for final_model.pt / .yaml")
+    a = p.parse_args(argv)
+    if a.threads:
+        torch.set_num_threads(a.threads)
+    pool = {
+        "scene": "random",
+        "difficulty": a.difficulty,
+        "scene_pool_size": a.pool_size,
+        "scene_pool_seed": a.pool_seed,
+    }
+    t0 = time.perf_counter()
+    obs, masks = scene_data(pool, jobs=a.jobs)
+    t1 = time.perf_counter()
+    solvable = float(masks.reshape(len(masks), -1).any(axis=1).mean())
+    print(
+        f"{len(obs)} scenes labelled in {t1 - t0:.0f} s ({solvable:.3f} with a valid pixel action)"
+    )
+    net = fit(obs, masks, epochs=a.epochs, seed=a.seed, width=a.width)
+    t2 = time.perf_counter()
+    config = {
+        "env_id": ENV_ID,
+        "env_kwargs": {**pool, **ENV_KWARGS},
+        "seed": a.seed,
+        "epochs": a.epochs,
+        "command": "python -m agents.learning.pixel_bc "
+        + " ".join(sys.argv[1:] if argv is None else argv),
+        "labelled_scenes": len(obs),
+        "solvable_fraction": solvable,
+        "wall_time_s": {"label": round(t1 - t0, 1), "fit": round(t2 - t1, 1)},
+    }
+    path = PixelPolicy(net).save(Path(a.out) / "final_model.pt", config)
+    print(json.dumps({"model": str(path), **config["wall_time_s"]}))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

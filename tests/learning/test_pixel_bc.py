@@ -1,0 +1,129 @@
+"""The pixel policy of Placement (agents.learning.pixel_bc): labels, symmetries, learning."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+torch = pytest.importorskip("torch")
+pytest.importorskip("yaml")
+
+import sensorplan_gym  # noqa: E402, F401
+from agents.learning import pixel_bc  # noqa: E402
+from sensorplan_gym.envs.placement import PlacementBatch  # noqa: E402
+
+SCENES = Path(__file__).resolve().parents[2] / "sensorplan_gym" / "scenes"
+
+
+def _turned(d: dict, k: int, flip: bool) -> dict:
+    """The scene dict turned ``k`` quarter turns counter-clockwise about its bounding box's
+    centre, then mirrored in x (the target's shape about its reference point too)."""
+    b = np.asarray(d["bounds"], dtype=float)
+    c = 0.5 * (b.min(axis=0) + b.max(axis=0))
+
+    def ring(pts, about=c):
+        p = np.asarray(pts, dtype=float) - about
+        for _ in range(k):
+            p = np.stack([-p[:, 1], p[:, 0]], axis=1)
+        if flip:
+            p[:, 0] = -p[:, 0]
+            p = p[::-1]
+        return (p + about).tolist()
+
+    out = dict(d)
+    out["bounds"] = ring(d["bounds"])
+    out["obstacles"] = [ring(o) for o in d["obstacles"]]
+    out["target"] = ring(d["target"], np.zeros(2))
+    out["goal"] = ring(d["goal"])
+    out["failure"] = ring(d["failure"])
+    out.pop("start", None)
+    return out
+
+
+@pytest.mark.parametrize(("k", "flip"), [(1, False), (2, True)])
+def test_augmentation_is_the_labels_of_the_turned_scene(k, flip):
+    """A symmetry of the square applied to a scene's observation and valid-action mask (the
+    aims follow: a quarter turn adds A / 4, a mirror maps aim k to A / 2 - k) equals the
+    observation and the exact labels of the scene turned the same way."""
+    d = json.loads((SCENES / "edr.json").read_text())
+    d["sensor"] = {**d["sensor"], "fov_deg": 120}
+    o0, m0 = pixel_bc.scene_data({"scene": d})
+    o1, m1 = pixel_bc.scene_data({"scene": _turned(d, k, flip)})
+    oa, ma = pixel_bc._augment(o0[0], m0[0], k, flip)
+    assert 0 < m0.sum() < m0.size // 4
+    # pixel centres on a region's edge can go either way after the turn's rounding
+    assert (ma != m1[0]).mean() < 2e-4
+    assert (oa != o1[0]).mean() < 0.01
+
+
+def test_valid_actions_are_the_env_rewards():
+    """The mask is the env's reward of each pixel action, played one by one."""
+    env = gym.make(
+        "sensorplan/Placement-v0", scene="edr", disable_env_checker=True, **pixel_bc.ENV_KWARGS
+    )
+    env.reset(seed=0)
+    mask = pixel_bc.valid_actions(env.unwrapped.batch, 0).reshape(-1)
+    rng = np.random.default_rng(0)
+    picks = np.concatenate(
+        [rng.choice(np.flatnonzero(mask), 20), rng.choice(np.flatnonzero(~mask), 20)]
+    )
+    for a in picks:
+        env.reset()
+        _, r, *_ = env.step(int(a))
+        assert (r > 0.5) == mask[a]
+
+
+def test_fit_learns_a_small_pool_and_round_trips(tmp_path):
+    """On a tiny pool the set likelihood drives the arg-max into the valid set of the
+    training scenes; the saved policy loads and acts the same."""
+    kw = {"scene": "random", "scene_pool_size": 6, "scene_pool_seed": 3}
+    obs, masks = pixel_bc.scene_data(kw)
+    solvable = masks.reshape(len(masks), -1).any(axis=1)
+    assert solvable.sum() >= 3
+    net = pixel_bc.fit(obs, masks, epochs=60, batch_size=6, width=16, augment=False, log=None)
+    pol = pixel_bc.PixelPolicy(net)
+    act, _ = pol.predict(obs)
+    hit = masks.reshape(len(masks), -1)[np.arange(len(obs)), act]
+    assert hit[solvable].mean() >= 0.8
+    cfg = {"env_id": pixel_bc.ENV_ID, "env_kwargs": {**kw, **pixel_bc.ENV_KWARGS}}
+    path = pol.save(tmp_path / "m.pt", cfg)
+    again, _ = pixel_bc.PixelPolicy.load(path).predict(obs)
+    assert np.array_equal(act, again)
+
+
+def test_pixel_actions_reject_bad_input():
+    with pytest.raises(ValueError, match="Placement's"):
+        gym.make("sensorplan/Navigate-v0", action_type="pixel")
+    with pytest.raises(ValueError, match="grid_size, not placement_grid"):
+        PlacementBatch(1, scene="edr", action_type="pixel", placement_grid=8)
+    with pytest.raises(ValueError, match="grid_views=True needs obs_type='grid'"):
+        PlacementBatch(1, scene="edr", grid_views=True)
+
+
+def test_evaluate_loads_a_pixel_policy(tmp_path):
+    """``sensorplan evaluate`` / ``benchmark`` play a saved pixel policy with its own
+    observation and action kwargs (from the config beside it); a ``.pt`` without that
+    config is refused by name."""
+    from agents.evaluation.evaluate import evaluate
+    from agents.learning.policies import check_policies, load_policy
+
+    kw = {"scene": "random", "scene_pool_size": 4, "scene_pool_seed": 5, "grid_size": 40}
+    obs, masks = pixel_bc.scene_data(kw)
+    net = pixel_bc.fit(obs, masks, epochs=2, batch_size=4, width=8, log=None)
+    cfg = {"env_id": pixel_bc.ENV_ID, "env_kwargs": {**pixel_bc.ENV_KWARGS, **kw}}
+    path = pixel_bc.PixelPolicy(net).save(tmp_path / "final_model.pt", cfg)
+    res = evaluate(
+        pixel_bc.ENV_ID, [str(path), "oracle"], episodes=3, env_kwargs={"scene": "edr"},
+        out=False, plot=False, verbose=False,
+    )  # fmt: skip
+    assert [p["episodes"] for p in res["policies"]] == [3, 3]
+    env = gym.make(pixel_bc.ENV_ID, scene="edr", disable_env_checker=True, **pixel_bc.ENV_KWARGS)
+    assert isinstance(load_policy(str(path), env), pixel_bc.PixelPolicy)
+    bare = tmp_path / "bare.pt"
+    bare.write_bytes(path.read_bytes())
+    with pytest.raises(ValueError, match="algo: pixel_bc"):
+        check_policies([str(bare)])
