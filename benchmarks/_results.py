@@ -53,6 +53,7 @@ NAMES = (
     "watch_declare",
     "watch_throughput",
     "reference",
+    "pixel_placement",
 )
 
 

@@ -1,0 +1,124 @@
+"""The pixel policy of Placement-v0 against PPO and the oracle on the ``hard`` level.
+
+    python -m benchmarks.pixel_placement [--episodes 100] [--seed 0] [--model PATH]
+
+``sensorplan benchmark --env sensorplan/Placement-v0 --level hard --splits test ood real``
+(:func:`agents.evaluation.benchmark.benchmark`) of the shipped pixel policy
+(``agents/pretrained/pixel_placement_hard.pt``, :mod:`agents.learning.pixel_bc`), the
+shipped PPO policy ``ppo_placement_random`` and the oracle, every policy on the same episode
+seeds.  ``test`` is the held-out pool of the level (seed 1; the policies were trained on pools
+of seed 0); ``ood`` and ``real`` the bundled and real maps, each one
+scene with its own sensor, so that a deterministic policy plays one decision there.  The
+policy's training record (labelling and fitting time, the share of training scenes with a
+right pixel action) comes from the config beside the model.  Needs the ``rl`` extra.
+"""
+
+from __future__ import annotations
+
+import argparse
+import tempfile
+import time
+from pathlib import Path
+from typing import Any
+
+from . import _results
+
+ENV = "sensorplan/Placement-v0"
+PRETRAINED = Path(__file__).resolve().parents[1] / "agents" / "pretrained"
+MODEL = PRETRAINED / "pixel_placement_hard.pt"
+PPO = PRETRAINED / "ppo_placement_random.zip"
+
+
+def main(argv: list[str] | None = None) -> int:
+    from agents.evaluation.benchmark import benchmark
+    from agents.learning.policies import model_config
+
+    ap = argparse.ArgumentParser(
+        prog="python -m benchmarks.pixel_placement", description=__doc__.split("\n\n")[0]
+    )
+    ap.add_argument("--episodes", type=int, default=100)
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--model", type=Path, default=MODEL, help="the pixel policy (.pt)")
+    _results.add_output_args(ap, "pixel_placement")
+    args = ap.parse_args(argv)
+    t0 = time.perf_counter()
+    cfg = model_config(args.model) or {}
+    with tempfile.TemporaryDirectory() as tmp:
+        res = benchmark(
+            ENV,
+            [str(args.model), str(PPO), "oracle"],
+            episodes=args.episodes,
+            seed=args.seed,
+            split_names=["test", "ood", "real"],
+            level="hard",
+            out=tmp,
+            verbose=False,
+        )
+    names = {str(args.model): "pixel policy", str(PPO): "PPO (ppo_placement_random)"}
+    rows = []
+    for split, r in res["splits"].items():
+        for p in r["policies"]:
+            rows.append(
+                {
+                    "split": split,
+                    "policy": names.get(p["spec"], p["spec"]),
+                    "successes": p["successes"],
+                    "episodes": p["episodes"],
+                    "distinct": p["distinct_episodes"],
+                    "ci95": list(p["success_ci95"]),
+                }
+            )
+    data: dict[str, Any] = {
+        "command": _results.command("benchmarks.pixel_placement", argv),
+        "machine": _results.machine(),
+        "model": args.model.name,
+        "training": {
+            k: cfg.get(k)
+            for k in ("command", "labelled_scenes", "solvable_fraction", "epochs", "wall_time_s")
+        },
+        "rows": rows,
+        "seconds": round(time.perf_counter() - t0, 1),
+    }
+    _results.write("pixel_placement", data, args.out, args.update_results)
+    print(render(data))
+    return 0
+
+
+def render(data: dict[str, Any]) -> str:
+    """The page fragment: success per split and policy, then the training record."""
+    order = ["pixel policy", "PPO (ppo_placement_random)", "oracle"]
+    splits = list(dict.fromkeys(r["split"] for r in data["rows"]))
+    by = {(r["split"], r["policy"]): r for r in data["rows"]}
+    lines = [
+        "| split | " + " | ".join(order) + " | distinct episodes |",
+        "|---|" + "---|" * (len(order) + 1),
+    ]
+    for s in splits:
+        cells = []
+        for p in order:
+            r = by.get((s, p))
+            if r is None:
+                cells.append("–")
+                continue
+            lo, hi = r["ci95"]
+            cells.append(f"{r['successes'] / r['episodes']:.2f} [{lo:.2f}, {hi:.2f}]")
+        d = next(by[(s, p)]["distinct"] for p in order if (s, p) in by)
+        lines.append(f"| {s} | " + " | ".join(cells) + f" | {d} |")
+    t = data["training"]
+    wall = t.get("wall_time_s") or {}
+    lines += [
+        "",
+        f"Success rate [95 % Wilson interval, sized by the distinct episodes], "
+        f"{data['rows'][0]['episodes']} episodes per split, deterministic policies, one training "
+        f"seed. The pixel policy (`{data['model']}`) was trained with `{t.get('command')}`: "
+        f"{t.get('labelled_scenes')} scenes labelled exactly in {wall.get('label')} s "
+        f"({t.get('solvable_fraction', 0):.3f} of them have a right pixel action), "
+        f"{t.get('epochs')} epochs in {wall.get('fit')} s on 2 CPU cores.",
+        "",
+        f"Measured with `{data['command']}` ({data['seconds']} s).",
+    ]
+    return "\n".join(lines) + "\n"
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
