@@ -202,11 +202,43 @@ def fit(
     return net
 
 
-class PixelPolicy:
-    """The arg-max action of a :class:`PixelNet` (SB3's ``predict`` signature)."""
+def _untransform(m: np.ndarray, k: int, flip: bool) -> np.ndarray:
+    """Maps ``(B, S, S, A)`` of a scene transformed by :func:`_augment` ``(k, flip)`` back to
+    the scene's own pixels and aims (the inverse symmetry: the mirror, then ``-k`` turns)."""
+    a = m.shape[-1]
+    if flip:
+        m = m[:, :, ::-1, :][..., (a // 2 - np.arange(a)) % a]
+    back = (4 - k) % 4
+    return np.roll(np.rot90(m, back, axes=(1, 2)), back * a // 4, axis=3)
 
-    def __init__(self, net: PixelNet) -> None:
+
+class PixelPolicy:
+    """The arg-max action of a :class:`PixelNet` (SB3's ``predict`` signature).  With
+    ``symmetries`` (the default) the log-probabilities are averaged over the eight symmetries
+    of the square (each observation turned and mirrored, the answer mapped back), so that the
+    policy is exactly equivariant.  Measured with the shipped policy: 47 against 43 right of the
+    hard level's 64 test-pool scenes (each once), and 0.77 against 0.79 on the benchmark's 100
+    test episodes (52 distinct scenes): no difference the samples can tell."""
+
+    def __init__(self, net: PixelNet, *, symmetries: bool = True) -> None:
         self.net = net.eval()
+        self.symmetries = bool(symmetries)
+
+    def log_probs(self, obs: np.ndarray) -> np.ndarray:
+        """``(B, S * S * A)`` log-probabilities of the pixel actions for observations ``(B, C,
+        S, S)`` (averaged over the symmetries when :attr:`symmetries`)."""
+        b, _, s, _ = obs.shape
+        a = self.net.aims
+        views = [(k, f) for k in range(4) for f in (False, True)] if self.symmetries else [(0, 0)]
+        acc = np.zeros((b, s, s, a))
+        with torch.no_grad():
+            for k, flip in views:
+                o = np.rot90(obs, k, axes=(2, 3))
+                if flip:
+                    o = o[:, :, :, ::-1]
+                lp = torch.log_softmax(self.net(torch.from_numpy(np.ascontiguousarray(o))), dim=1)
+                acc += _untransform(lp.numpy().reshape(b, s, s, a), k, bool(flip))
+        return (acc / len(views)).reshape(b, -1)
 
     def predict(
         self,
@@ -218,13 +250,13 @@ class PixelPolicy:
         """Actions (ints) for one observation ``(C, S, S)`` or a batch ``(B, C, S, S)``."""
         obs = np.asarray(observation)
         one = obs.ndim == 3
-        with torch.no_grad():
-            logits = self.net(torch.from_numpy(obs[None] if one else obs))
+        lp = self.log_probs(obs[None] if one else obs)
         if deterministic:
-            act = logits.argmax(dim=1)
+            out = lp.argmax(axis=1)
         else:
-            act = torch.distributions.Categorical(logits=logits).sample()
-        out = act.numpy().astype(np.int64)
+            logits = torch.from_numpy(lp)
+            out = torch.distributions.Categorical(logits=logits).sample().numpy()
+        out = out.astype(np.int64)
         return (out[0] if one else out), state
 
     def save(self, path: str | Path, config: dict[str, Any]) -> Path:
