@@ -32,6 +32,7 @@ from .checks import EXTRA_OF_MODULE, check_writable_file, missing_extra_message
 __all__ = ["EXTRA_OF_MODULE", "build_parser", "main"]
 
 ENV_CHOICES_HELP = "sensorplan/Placement-v0, sensorplan/Navigate-v0 or sensorplan/Recognize-v0"
+POLICIES_HELP = "'oracle', 'random' and/or paths to model zips or pixel policies (.pt)"
 
 
 def _json_dict(text: str) -> dict:
@@ -149,9 +150,7 @@ def build_parser() -> argparse.ArgumentParser:
         "and a PNG plot.",
     )
     e.add_argument("--env", required=True, help=ENV_CHOICES_HELP)
-    e.add_argument(
-        "--policies", nargs="+", required=True, help="'oracle', 'random' and/or paths to model zips"
-    )
+    e.add_argument("--policies", nargs="+", required=True, help=POLICIES_HELP)
     e.add_argument("--episodes", type=int, default=100)
     e.add_argument("--seed", type=int, default=0)
     e.add_argument(
@@ -188,9 +187,7 @@ def build_parser() -> argparse.ArgumentParser:
         "bundled scene, with the difficulty knob reported; writes benchmark.json/.csv.",
     )
     bm.add_argument("--env", required=True, help=ENV_CHOICES_HELP)
-    bm.add_argument(
-        "--policies", nargs="+", required=True, help="'oracle', 'random' and/or paths to model zips"
-    )
+    bm.add_argument("--policies", nargs="+", required=True, help=POLICIES_HELP)
     bm.add_argument("--episodes", type=int, default=100)
     bm.add_argument("--seed", type=int, default=0)
     bm.add_argument(
