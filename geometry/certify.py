@@ -50,6 +50,7 @@ from ._common import (
     scene_domain,
     shrink_for_position,
 )
+from ._domain import Domain, domain_from_geometry
 from ._frame import world_messages
 from ._shapes import ccw_ring, union_all
 from .mixed import _point_side, point_strips
@@ -68,6 +69,11 @@ __all__ = ["SweptBounds", "hausdorff_bounds", "proven_inner", "swept_bounds"]
 HAUSDORFF_CELLS = 64
 #: ... until the upper and lower bounds agree to this fraction of the upper one.
 HAUSDORFF_REL = 0.05
+#: The proven inner bound over cells covering G (:func:`proven_inner`) starts from
+#: triangles with sides of at most this fraction of the target's size ...
+CELL_SIZE = 0.25
+#: ... and refines them (``densify``) while there are at most this many.
+MAX_CELLS = 1024
 
 
 @dataclass(frozen=True)
@@ -86,8 +92,10 @@ class SweptBounds:
     hausdorff_lower : a lower bound on it (scene units).
     samples : how many exact stationary shadows make up the outer bound.
     proven_inner : an inner bound proven without any claim about the sweep's tracing
-        (:func:`proven_inner`; world frame), or ``None`` where that argument does not apply
-        (5.2 and mixed G/H, a target that is not star-shaped, ``eps_aim`` > 0).  Looser than
+        (:func:`proven_inner`; world frame) for every swept query without aim error: the
+        whole outline or 5.2's wanted pieces, point/polygon/mixed G and H, star-shaped or
+        not.  ``None`` with ``eps_aim`` > 0 (the argument does not cover the dropped
+        narrow fans) or when a cell of G stays wider than the target.  Usually looser than
         ``inner``; ``densify`` tightens it.
     proven_hausdorff : the upper Hausdorff bound between ``proven_inner`` and ``outer``
         (``None`` with it).
@@ -125,7 +133,9 @@ def swept_bounds(
         of a scene whose G or H is a polygon (paper 5.2, mixed point/polygon).
     theta, eps_pos, eps_aim, tol, timeout, progress : as in those queries.
     densify : extra exact stationary shadows per edge of G's (H's) boundary, evenly
-        spaced, for the outer bound only (tighter, one stationary query each).
+        spaced, for the outer bound (tighter, one stationary query each); the proven
+        inner bound's pieces are cut there too, and its cells over G (5.2, non-star
+        targets) are halved ``densify`` more times (see :func:`proven_inner`).
 
     Returns
     -------
@@ -153,8 +163,7 @@ def swept_bounds(
             densify,
         )  # fmt: skip
         if recognizable:
-            inner, outer, n = _recognizable_bounds(local, *args)
-            proven = None
+            inner, outer, n, proven = _recognizable_bounds(local, *args)
         else:
             inner, outer, n, proven = _side(local, fr.region(target_in), *args)
     inner, outer = fr.to_world(inner), fr.to_world(outer)
@@ -204,10 +213,14 @@ def _side(
     allowed = sink["allowed"]
     outer = polygonal(shapely.difference(allowed, union))
     proven = None
-    if strips is None and stand_in is None and eps_aim == 0.0:
-        # star-shaped target, whole outline: an inner bound that needs no claim about
-        # the tracing (docs/DESIGN.md, "Certified swept answers")
-        proven = proven_inner(scene, sink["region"], theta, [q for q, _ in samples], allowed, grid)
+    if eps_aim == 0.0:
+        # an inner bound that needs no claim about the tracing (docs/DESIGN.md, "Certified
+        # swept answers"): over the boundary of G for a star-shaped target with the whole
+        # outline wanted, else over cells covering G
+        proven = proven_inner(
+            scene, sink["region"], theta, [q for q, _ in samples], allowed, grid,
+            strips=strips, boundary=strips is None and stand_in is None, refine=densify,
+        )  # fmt: skip
         if proven is not None and eps_pos > 0:
             proven = shrink_for_position(proven, allowed, eps_pos)
     if eps_pos > 0:
@@ -228,23 +241,70 @@ def proven_inner(
     allowed: shapely.Geometry,
     grid: float,
     max_split: int = 6,
+    strips: list[shapely.Geometry] | None = None,
+    boundary: bool | None = None,
+    refine: int = 0,
 ) -> shapely.Geometry | None:
-    """A proven inner bound of the swept partial region (whole outline wanted), local frame.
+    """A proven inner bound of a swept partial region, local frame, or ``None``.
 
-    The reference points ``qs`` (on the boundary of the polygon ``region``) and the
-    region's vertices cut its boundary into pieces sigma = [q_a, q_b].  For every q on
-    sigma the target A_q contains B_sigma = the points of A covered at every position of
-    sigma (A_{q_a} minus the parallelograms its edges sweep along sigma), so a placement
-    outside A (+) G blind to A_q is blind to B_sigma: the segment to a visible point of
-    B_sigma enters A_q at a visible point first.  Hence the union of the shadows over
-    the boundary lies in the union of the exact stationary shadows S(B_sigma) of the
-    largest part of each B_sigma, and ``allowed`` minus the latter is inside the exact
-    region (given that the boundary of G suffices: star-shaped target).  A piece whose
-    B_sigma is empty (longer than the target is wide) is halved, up to ``max_split``
+    ``region`` (a polygon, G) is covered by *cells* C: with ``boundary`` (the default
+    for a star-shaped target with the whole outline wanted, where the boundary of G
+    suffices) the pieces sigma = [q_a, q_b] into which the reference points ``qs`` and
+    the region's vertices cut its boundary; otherwise the triangles of a constrained
+    Delaunay triangulation of the whole region.  For every q in a cell C the target A_q
+    contains B_C = the points of A covered at every position of C (A at a vertex of C
+    minus the sets e (+) C that its edges e sweep over C: a point leaves A_q along a
+    path in C only by crossing an edge), so a placement p outside A (+) G that sees a
+    point b of B_C sees A_q: the segment p -> b enters A_q at a first point y, which p
+    sees.  With overlap ``strips`` (5.2: U_i, the unwanted part of edge i, a fixed set)
+    y must also be wanted: y lies on an edge e_i of A_q, hence in e_i (+) C, so when the
+    segment avoids O_C = the union of (e_i (+) C) n U_i, y is outside U_i.  O_C becomes
+    an obstacle (grown by ``1e-7`` of the scene's size, B_C shrunk by twice that, so
+    that they do not touch).  Hence the union of the shadows S(q) over the region lies
+    in the union of the exact stationary shadows of the largest part of each B_C (among
+    the obstacles and O_C), and ``allowed`` minus the latter is inside the exact region.
+    The triangles start with sides of at most :data:`CELL_SIZE` times the target's size,
+    halved ``refine`` more times (smaller cells, smaller O_C: a tighter bound, one
+    stationary query per cell), within :data:`MAX_CELLS`.  A cell whose B_C is still
+    empty (wider than the target) is halved (a triangle: quartered), up to ``max_split``
     times; ``None`` if one stays empty.  Snap-rounded on ``grid`` like the outer bound.
+    No claim about the sweep's tracing enters.
     """
     if region.geom_type != "Polygon":
         return None
+    if boundary is None:
+        boundary = strips is None
+    if boundary:
+        cells = _boundary_cells(region, qs)
+    else:
+        size = CELL_SIZE * _diag(scene.target_at(0.0, 0.0, theta)) / 2**refine
+        cells = _region_cells(region, size)
+    dom = scene_domain(scene)
+    delta = 1e-7 * max(_diag(allowed), 1e-300)
+    shadows = []
+    while cells:
+        cell, depth = cells.pop()
+        a = scene.target_at(float(cell[0, 0]), float(cell[0, 1]), theta)
+        core, swept = _covered(a, cell - cell[0])
+        if core is not None and strips is not None:
+            core, env = _among_strips(scene, core, swept, strips, delta)
+        else:
+            env = dom
+        if core is None:
+            if depth >= max_split:
+                return None
+            cells += [(c, depth + 1) for c in _split(cell)]
+            continue
+        hole = _hole_ring(core)
+        seen = weak_visibility(env, hole, np.ones(len(hole), dtype=bool))
+        shadows.append(polygonal(shapely.difference(allowed, seen)))
+    union = union_all(shadows, grid_size=grid) if shadows else shapely.Polygon()
+    return polygonal(shapely.difference(allowed, union))
+
+
+def _boundary_cells(region: shapely.Polygon, qs: list[np.ndarray]) -> list:
+    """The pieces [q_a, q_b] of the region's boundary cut at its vertices and at ``qs``
+    ((2, 2) arrays, depth 0)."""
     ring = region.exterior
     length = ring.length
     verts = np.asarray(ring.coords)[:-1]
@@ -258,39 +318,81 @@ def proven_inner(
     )
     pos = np.unique(np.clip(pos, 0.0, length))
     stops = np.append(pos, pos[0] + length)
-    pieces = [(a, b, 0) for a, b in zip(stops[:-1], stops[1:], strict=True) if b - a > 1e-12]
-    dom = scene_domain(scene)
-    shadows = []
-    while pieces:
-        a, b, depth = pieces.pop()
-        qa = np.asarray(ring.interpolate(a % length).coords[0])
-        qb = np.asarray(ring.interpolate(b % length).coords[0])
-        core = _covered(scene.target_at(float(qa[0]), float(qa[1]), theta), qb - qa)
-        if core is None:
-            if depth >= max_split:
-                return None
-            mid = 0.5 * (a + b)
-            pieces += [(a, mid, depth + 1), (mid, b, depth + 1)]
-            continue
-        hole = _hole_ring(core)
-        seen = weak_visibility(dom, hole, np.ones(len(hole), dtype=bool))
-        shadows.append(polygonal(shapely.difference(allowed, seen)))
-    union = union_all(shadows, grid_size=grid) if shadows else shapely.Polygon()
-    return polygonal(shapely.difference(allowed, union))
+    out = []
+    for a, b in zip(stops[:-1], stops[1:], strict=True):
+        if b - a > 1e-12:
+            qa = np.asarray(ring.interpolate(a % length).coords[0])
+            qb = np.asarray(ring.interpolate(b % length).coords[0])
+            out.append((np.stack([qa, qb]), 0))
+    return out
 
 
-def _covered(a: shapely.Polygon, d: np.ndarray) -> shapely.Polygon | None:
-    """The largest part of the points of ``a`` that stay in ``a + t d`` for all t in
-    [0, 1] (``a`` minus the parallelograms its edges sweep along ``d``), or ``None``."""
-    c = np.asarray(a.exterior.coords)
-    e = c[1:] - c[:-1]
-    swept = np.abs(e[:, 0] * d[1] - e[:, 1] * d[0]) > 0.0
-    quads = np.stack([c[:-1], c[1:], c[1:] + d, c[:-1] + d], axis=1)[swept]
-    core = a if len(quads) == 0 else shapely.difference(a, union_all(shapely.polygons(quads)))
+def _region_cells(region: shapely.Polygon, size: float) -> list:
+    """Triangles ((3, 2) arrays, depth 0) covering the region, holes excluded: a
+    constrained Delaunay triangulation, quartered level by level until every side is at
+    most ``size`` long or another level would pass :data:`MAX_CELLS` triangles."""
+    tris = shapely.get_parts(shapely.constrained_delaunay_triangles(region))
+    cells = [np.asarray(t.exterior.coords)[:3] for t in tris if t.area > 0.0]
+    while 4 * len(cells) <= MAX_CELLS:
+        side = max(float(np.hypot(*(c - np.roll(c, 1, axis=0)).T).max()) for c in cells)
+        if side <= size:
+            break
+        cells = [t for c in cells for t in _split(c)]
+    return [(c, 0) for c in cells]
+
+
+def _split(cell: np.ndarray) -> list[np.ndarray]:
+    """A segment halved, a triangle quartered (they cover the cell)."""
+    if len(cell) == 2:
+        m = 0.5 * (cell[0] + cell[1])
+        return [np.stack([cell[0], m]), np.stack([m, cell[1]])]
+    a, b, c = cell
+    ab, bc, ca = 0.5 * (a + b), 0.5 * (b + c), 0.5 * (c + a)
+    return [np.stack(t) for t in ((a, ab, ca), (ab, b, bc), (ca, bc, c), (ab, bc, ca))]
+
+
+def _covered(a: shapely.Polygon, d: np.ndarray) -> tuple[shapely.Polygon | None, np.ndarray]:
+    """The largest part of the points of ``a`` that stay in ``a + v`` for every ``v`` in
+    the convex hull of the offsets ``d`` ((k, 2), ``d[0] = 0``): ``a`` minus the sets
+    e (+) conv(d) its edges e sweep (each the convex hull of the edge's ends moved by
+    every offset), or ``None``; and those swept sets per edge of ``a`` (an array of
+    geometries in the order of :func:`ccw_ring`, empty where an edge is parallel to a
+    segment cell)."""
+    r = ccw_ring(a)  # edge i from vertex i: the order of the strips U_i
+    ends = np.stack([r, np.roll(r, -1, axis=0)], axis=1)  # (E, 2, 2)
+    pts = (ends[:, :, None, :] + d[None, None, :, :]).reshape(len(ends), -1, 2)
+    swept = shapely.convex_hull(shapely.multipoints(pts))
+    swept = np.where(shapely.area(swept) > 0.0, swept, shapely.Polygon())
+    real = swept[shapely.area(swept) > 0.0]
+    core = a if len(real) == 0 else shapely.difference(a, union_all(real))
     parts = [g for g in shapely.get_parts(polygonal(core)) if g.area > 0.0]
     if not parts:
-        return None
-    return max(parts, key=lambda g: g.area)
+        return None, swept
+    return max(parts, key=lambda g: g.area), swept
+
+
+def _among_strips(
+    scene: Scene,
+    core: shapely.Polygon,
+    swept: np.ndarray,
+    strips: list[shapely.Geometry],
+    delta: float,
+) -> tuple[shapely.Polygon | None, Domain]:
+    """``core`` shrunk by ``2 delta`` and the free space with O_C = the union of
+    (edge i's swept set) n U_i grown by ``delta`` as an obstacle (:func:`proven_inner`);
+    ``(None, ...)`` when nothing of ``core`` is left."""
+    blocks = shapely.intersection(swept, np.asarray(strips, dtype=object))
+    blocks = blocks[shapely.area(blocks) > 0.0]
+    if len(blocks) == 0:
+        return core, scene_domain(scene)
+    obstacle = shapely.buffer(union_all(blocks), delta, join_style="mitre")
+    free = polygonal(shapely.difference(scene.free_space, obstacle))
+    shrunk = shapely.buffer(core, -2 * delta, join_style="mitre")
+    left = polygonal(shapely.difference(shrunk, obstacle))
+    parts = [g for g in shapely.get_parts(left) if g.area > 0.0]
+    if not parts:
+        return None, scene_domain(scene)
+    return max(parts, key=lambda g: g.area), domain_from_geometry(free)
 
 
 def _whole_shadow(scene: Scene, q: np.ndarray, theta: float, eps_aim: float) -> shapely.Geometry:
@@ -309,8 +411,9 @@ def _recognizable_bounds(
     tol: float,
     budget: Budget,
     densify: int,
-) -> tuple[shapely.Geometry, shapely.Geometry, int]:
-    """(inner, outer, samples) of the partial-model recognizable region, local frame."""
+) -> tuple[shapely.Geometry, shapely.Geometry, int, shapely.Geometry | None]:
+    """(inner, outer, samples, proven inner or None) of the partial-model recognizable
+    region, local frame."""
     g, h = scene.goal_geom, scene.failure_geom
     if g.geom_type == "Point" and h.geom_type == "Point":
         raise ValueError(
@@ -324,16 +427,17 @@ def _recognizable_bounds(
         pt_name = next(w for w in names if scene.region(w).geom_type == "Point")
         poly_name = next(w for w in names if w != pt_name)
         point, poly = scene.region(pt_name), scene.region(poly_name)
-        inner, outer, n, _ = _side(
+        inner, outer, n, proven = _side(
             scene, poly_name, theta, eps_pos, eps_aim, tol, budget, densify,
             strips=point_strips(target, point, *acc),
         )  # fmt: skip
         vs_poly = overlap_strips(target, poly, *acc)
-        still = _point_side(scene, point, theta, vs_poly, eps_pos, eps_aim)
+        still = _point_side(scene, point, theta, vs_poly, eps_pos, eps_aim)  # exact
         return (
             polygonal(shapely.intersection(inner, still)),
             polygonal(shapely.intersection(outer, still)),
             n,
+            None if proven is None else polygonal(shapely.intersection(proven, still)),
         )
     n_g, n_h = (
         len(shapely.get_coordinates(scene.region(w).boundary)) - 1 for w in ("goal", "failure")
@@ -352,10 +456,16 @@ def _recognizable_bounds(
         )  # fmt: skip
         for (me, other), off in ((("goal", "failure"), 0), (("failure", "goal"), n_g))
     ]
+    proven = (
+        None
+        if sides[0][3] is None or sides[1][3] is None
+        else polygonal(shapely.intersection(sides[0][3], sides[1][3]))
+    )
     return (
         polygonal(shapely.intersection(sides[0][0], sides[1][0])),
         polygonal(shapely.intersection(sides[0][1], sides[1][1])),
         sides[0][2] + sides[1][2],
+        proven,
     )
 
 
