@@ -72,8 +72,8 @@ HAUSDORFF_REL = 0.05
 #: The proven inner bound over cells covering G (:func:`proven_inner`) starts from
 #: triangles with sides of at most this fraction of the target's size ...
 CELL_SIZE = 0.25
-#: ... and refines them (``densify``) while there are at most this many.
-MAX_CELLS = 1024
+#: ... within a budget of this many cells (times ``4**densify``), splits included.
+MAX_CELLS = 256
 
 
 @dataclass(frozen=True)
@@ -95,8 +95,8 @@ class SweptBounds:
         (:func:`proven_inner`; world frame) for every swept query without aim error: the
         whole outline or 5.2's wanted pieces, point/polygon/mixed G and H, star-shaped or
         not.  ``None`` with ``eps_aim`` > 0 (the argument does not cover the dropped
-        narrow fans) or when a cell of G stays wider than the target.  Usually looser than
-        ``inner``; ``densify`` tightens it.
+        narrow fans) or when a cell of G stays wider than the target (a target much
+        thinner than G is wide).  Usually looser than ``inner``; ``densify`` tightens it.
     proven_hausdorff : the upper Hausdorff bound between ``proven_inner`` and ``outer``
         (``None`` with it).
     """
@@ -265,24 +265,30 @@ def proven_inner(
     the obstacles and O_C), and ``allowed`` minus the latter is inside the exact region.
     The triangles start with sides of at most :data:`CELL_SIZE` times the target's size,
     halved ``refine`` more times (smaller cells, smaller O_C: a tighter bound, one
-    stationary query per cell), within :data:`MAX_CELLS`.  A cell whose B_C is still
-    empty (wider than the target) is halved (a triangle: quartered), up to ``max_split``
-    times; ``None`` if one stays empty.  Snap-rounded on ``grid`` like the outer bound.
+    stationary query per cell), while they number at most a quarter of the budget of
+    ``MAX_CELLS * 4**refine`` cells.  A cell whose B_C is still empty (wider than the
+    target) is halved (a triangle: quartered), up to ``max_split`` times; ``None`` if one
+    stays empty or the triangles pass the budget (a target much thinner than G is wide).
+    Snap-rounded on ``grid`` like the outer bound.
     No claim about the sweep's tracing enters.
     """
     if region.geom_type != "Polygon":
         return None
     if boundary is None:
         boundary = strips is None
+    budget = None
     if boundary:
         cells = _boundary_cells(region, qs)
     else:
+        budget = MAX_CELLS * 4**refine
         size = CELL_SIZE * _diag(scene.target_at(0.0, 0.0, theta)) / 2**refine
-        cells = _region_cells(region, size)
+        cells = _region_cells(region, size, budget // 4)
     dom = scene_domain(scene)
     delta = 1e-7 * max(_diag(allowed), 1e-300)
     shadows = []
     while cells:
+        if budget is not None and len(shadows) + len(cells) > budget:
+            return None  # a target too thin for cells of G: no bound in reasonable time
         cell, depth = cells.pop()
         a = scene.target_at(float(cell[0, 0]), float(cell[0, 1]), theta)
         core, swept = _covered(a, cell - cell[0])
@@ -327,13 +333,13 @@ def _boundary_cells(region: shapely.Polygon, qs: list[np.ndarray]) -> list:
     return out
 
 
-def _region_cells(region: shapely.Polygon, size: float) -> list:
+def _region_cells(region: shapely.Polygon, size: float, cap: int) -> list:
     """Triangles ((3, 2) arrays, depth 0) covering the region, holes excluded: a
     constrained Delaunay triangulation, quartered level by level until every side is at
-    most ``size`` long or another level would pass :data:`MAX_CELLS` triangles."""
+    most ``size`` long or another level would pass ``cap`` triangles."""
     tris = shapely.get_parts(shapely.constrained_delaunay_triangles(region))
     cells = [np.asarray(t.exterior.coords)[:3] for t in tris if t.area > 0.0]
-    while 4 * len(cells) <= MAX_CELLS:
+    while 4 * len(cells) <= cap:
         side = max(float(np.hypot(*(c - np.roll(c, 1, axis=0)).T).max()) for c in cells)
         if side <= size:
             break

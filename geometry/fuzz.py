@@ -42,6 +42,13 @@ demands equality up to the output's rounding.
 near-duplicate target vertices, flush obstacles over both ends of a target edge, a target
 under an opening, a second obstacle sharing a flush one's edge.
 
+``certify=True`` (``--certify``, with ``swept``; issue 25 item 2) also runs
+:func:`geometry.swept_bounds` (no aim error) and demands (``inclusion``) proven inner ⊆
+outer and inner ⊆ outer, the proven inner ⊆ the stationary partial region at the vertices
+of G and the sampled configurations, and for polygonal or mixed G/H the 5.2 bounds' proven
+inner ⊆ outer, ⊆ R(G) and ⊆ R(H) (a proven inner bound that is ``None``, for a target
+too thin for the cells of G, is skipped).
+
 ``nonstar=True`` (``--nonstar``) draws targets with an empty kernel (U, comb, hook), and
 with ``swept`` scenes that mix a point and a polygon also run the mixed recognizable
 region (``⊆`` the partial regions of both; issue 25).
@@ -66,6 +73,7 @@ from typing import Any
 import numpy as np
 import shapely
 
+from .certify import swept_bounds
 from .complete import complete_region
 from .partial import partial_region
 from .recognize import recognizable_region
@@ -575,6 +583,32 @@ def _translated(d: dict, o: float) -> dict:
     return out
 
 
+def _check_bounds(b: Any, name: str, incl: Callable) -> None:
+    """The certified bounds of one swept query: both inner bounds inside outer (a proven
+    inner bound may be ``None``: a target too thin for the cells of G)."""
+    incl(b.inner, b.outer, f"{name}: inner ⊆ outer")
+    incl(b.proven_inner, b.outer, f"{name}: proven inner ⊆ outer")  # None: not available
+
+
+def _certify_recognizable(
+    s: Scene, theta: float, sides: list, incl: Callable, out: list[Finding], times: dict
+) -> None:
+    """The 5.2 (or mixed) bounds: :func:`_check_bounds`, and the proven inner bound inside
+    the swept or stationary partial regions ``sides`` (R(G), R(H))."""
+    b = _timed(
+        lambda: swept_bounds(s, recognizable=True, theta=theta),
+        "5.2 bounds",
+        out,
+        times,
+        3 * HANG_S,
+    )
+    if b is None:
+        return
+    _check_bounds(b, "5.2 bounds", incl)
+    for side in sides:
+        incl(b.proven_inner, side, "5.2 proven inner ⊆ R(G), R(H)")
+
+
 def check_scene(
     d: dict[str, Any],
     *,
@@ -583,13 +617,15 @@ def check_scene(
     seed: int = 0,
     hang_s: float = HANG_S,
     frames: bool = False,
+    certify: bool = False,
 ) -> tuple[list[Finding], dict[str, float]]:
     """Run every query type on the scene dictionary ``d`` (see the module docstring);
     returns the findings and the time of every query (seconds).  ``hang_s``: the
     time limit of one query (wall clock).  ``frames=True`` also maps the scene into
     the frames of issue 26 (scaled by 1e-3 and 1e3, moved to UTM-size coordinates;
     neither map is exact in binary) and demands the same regions mapped back
-    (``frame``), and checks the 5.2 region against the stationary recognizable one."""
+    (``frame``), and checks the 5.2 region against the stationary recognizable one.
+    ``certify=True`` (with ``swept``) checks the certified bounds (module docstring)."""
     d = {k: v for k, v in d.items() if k != "features"}
     s = Scene.from_dict(d)
     rng = np.random.default_rng(seed)
@@ -662,6 +698,7 @@ def check_scene(
             "partial in",
             lambda: partial_region(s, target_in="goal", theta=theta, conservative=True),
         )
+        stationary = []  # the stationary partial regions at configurations of G
         for v in verts[:4]:
             pv = _timed(
                 lambda v=v: partial_region(s, target_at=(v[0], v[1], theta)),
@@ -670,6 +707,7 @@ def check_scene(
                 {},
             )
             incl(p_in, pv, "translating ⊆ stationary (partial)")
+            stationary.append(pv)
         if len(s.goal) > 1:
             # ... and at sampled configurations of G: on its boundary (where the sweep
             # runs, between its samples: issue 26.3) and inside it
@@ -681,6 +719,19 @@ def check_scene(
                     {},
                 )
                 incl(p_in, pq, "translating ⊆ stationary at sampled q (partial)")
+                stationary.append(pq)
+        if certify and len(s.goal) > 1:
+            b = _timed(
+                lambda: swept_bounds(s, target_in="goal", theta=theta),
+                "swept bounds",
+                out,
+                times,
+                3 * HANG_S,  # a sweep, its sampled shadows and the proven cells
+            )
+            if b is not None:
+                _check_bounds(b, "swept bounds", incl)
+                for st in stationary:
+                    incl(b.proven_inner, st, "proven inner ⊆ stationary (partial)")
         if poly_gh:
             r52 = run(
                 "recognizable partial 5.2",
@@ -698,6 +749,8 @@ def check_scene(
             )
             incl(r52, p_g, "recognizable 5.2 ⊆ R(G)")
             incl(r52, p_h, "recognizable 5.2 ⊆ R(H)")
+            if certify:
+                _certify_recognizable(s, theta, [p_g, p_h], incl, out, times)
             if frames and r52 is not None and theta == 0.0:
                 # ... and it is recognizable for every pose pair: G and H shrunk to one
                 # vertex each gives the stationary recognizable region (issue 25 item 3)
@@ -715,6 +768,7 @@ def check_scene(
                 "recognizable partial mixed",
                 lambda: recognizable_region(s, model="partial", theta=theta, conservative=True),
             )
+            sides = []
             for w, reg in (("G", s.goal), ("H", s.failure)):
                 which = "goal" if w == "G" else "failure"
                 if len(reg) == 1:
@@ -732,6 +786,9 @@ def check_scene(
                         {},
                     )
                 incl(rmx, rw, f"recognizable mixed ⊆ R({w})")
+                sides.append(rw)
+            if certify:
+                _certify_recognizable(s, theta, sides, incl, out, times)
     if frames:
         _check_frames(s, d, q_at, theta, out, swept=swept, poly_gh=poly_gh)
     if translate:
@@ -900,6 +957,7 @@ def run_many(
     frames: bool = False,
     nonstar: bool = False,
     jobs: int = 1,
+    certify: bool = False,
 ) -> dict[str, Any]:
     """Fuzz ``n`` scenes (seeds ``seed .. seed + n - 1``); returns a summary dictionary.
 
@@ -910,7 +968,8 @@ def run_many(
     if jobs > 1 and n > 1:
         return _run_parallel(
             n, seed, jobs, dict(swept=swept, max_edges=max_edges, verbose=verbose,
-                                contacts=contacts, frames=frames, nonstar=nonstar),
+                                contacts=contacts, frames=frames, nonstar=nonstar,
+                                certify=certify),
         )  # fmt: skip
     kinds: Counter[str] = Counter()
     failing: list[dict[str, Any]] = []
@@ -922,7 +981,7 @@ def run_many(
         if d is None:
             continue
         n_valid += 1
-        found, times = check_scene(d, swept=swept, seed=i, frames=frames)
+        found, times = check_scene(d, swept=swept, seed=i, frames=frames, certify=certify)
         for k, v in times.items():
             slowest[k] = max(slowest.get(k, 0.0), v)
         for f in found:
@@ -989,6 +1048,11 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument(
         "--nonstar", action="store_true", help="non-star-shaped targets (U, comb, hook; issue 25)"
     )
+    ap.add_argument(
+        "--certify",
+        action="store_true",
+        help="with --swept: also the certified bounds (swept_bounds; issue 25)",
+    )
     ap.add_argument("--jobs", type=int, default=1, help="processes (default 1)")
     ap.add_argument("--json", help="write the summary (with failing seeds) to this file")
     ap.add_argument("-v", "--verbose", action="store_true")
@@ -1003,6 +1067,7 @@ def main(argv: list[str] | None = None) -> int:
         frames=a.frames,
         nonstar=a.nonstar,
         jobs=a.jobs,
+        certify=a.certify,
     )
     if a.json:
         with open(a.json, "w", encoding="utf-8") as f:
