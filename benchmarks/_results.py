@@ -54,6 +54,7 @@ NAMES = (
     "watch_throughput",
     "reference",
     "pixel_placement",
+    "certified",
 )
 
 
