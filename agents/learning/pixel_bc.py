@@ -163,16 +163,18 @@ def fit(
     width: int = 48,
     augment: bool = True,
     log: Any = print,
+    device: str = "cpu",
 ) -> PixelNet:
     """A :class:`PixelNet` trained on the scenes ``obs`` ``(N, C, S, S)`` with valid-action
     masks ``masks`` ``(N, S, S, A)`` (scenes with no valid action are skipped): Adam with a
     cosine schedule, the set likelihood :func:`set_nll`, a random symmetry of the square per
-    sample and epoch when ``augment``."""
+    sample and epoch when ``augment``.  ``device``: where to train (a torch device name,
+    e.g. ``"cuda"``; the same draws on every device); the net is returned on the CPU."""
     torch.manual_seed(seed)
     rng = np.random.default_rng(seed)
     keep = masks.reshape(len(masks), -1).any(axis=1)
     obs, masks = obs[keep], masks[keep]
-    net = PixelNet(obs.shape[1], masks.shape[-1], width=width)
+    net = PixelNet(obs.shape[1], masks.shape[-1], width=width).to(device)
     opt = torch.optim.Adam(net.parameters(), lr=lr)
     steps = epochs * max(1, -(-len(obs) // batch_size))
     sched = torch.optim.lr_scheduler.CosineAnnealingLR(opt, steps)
@@ -190,7 +192,8 @@ def fit(
                 m = np.stack([p[1] for p in pairs])
             else:
                 o, m = obs[rows], masks[rows]
-            loss = set_nll(net(torch.from_numpy(o)), torch.from_numpy(m.reshape(len(rows), -1)))
+            valid = torch.from_numpy(m.reshape(len(rows), -1)).to(device)
+            loss = set_nll(net(torch.from_numpy(o).to(device)), valid)
             opt.zero_grad()
             loss.backward()
             opt.step()
@@ -199,7 +202,7 @@ def fit(
         if log is not None:
             log(f"epoch {ep + 1}/{epochs}: set NLL {total / len(obs):.3f}")
     net.eval()
-    return net
+    return net.cpu()
 
 
 def _untransform(m: np.ndarray, k: int, flip: bool) -> np.ndarray:
@@ -302,6 +305,9 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--jobs", type=int, default=None, help="processes that build the pool")
     p.add_argument("--threads", type=int, default=None, help="torch threads")
+    p.add_argument(
+        "--device", default="cpu", help='where to fit: "cpu" (default), "cuda" or "auto"'
+    )
     p.add_argument("--out", default="runs/pixel_bc", help="folder for final_model.pt / .yaml")
     a = p.parse_args(argv)
     if a.threads:
@@ -319,7 +325,10 @@ def main(argv: list[str] | None = None) -> int:
     print(
         f"{len(obs)} scenes labelled in {t1 - t0:.0f} s ({solvable:.3f} with a valid pixel action)"
     )
-    net = fit(obs, masks, epochs=a.epochs, seed=a.seed, width=a.width)
+    device = a.device
+    if device == "auto":
+        device = "cuda" if torch.cuda.is_available() else "cpu"
+    net = fit(obs, masks, epochs=a.epochs, seed=a.seed, width=a.width, device=device)
     t2 = time.perf_counter()
     config = {
         "env_id": ENV_ID,
@@ -331,6 +340,7 @@ def main(argv: list[str] | None = None) -> int:
         "labelled_scenes": len(obs),
         "solvable_fraction": solvable,
         "wall_time_s": {"label": round(t1 - t0, 1), "fit": round(t2 - t1, 1)},
+        "fit_device": device,
     }
     path = PixelPolicy(net).save(Path(a.out) / "final_model.pt", config)
     print(json.dumps({"model": str(path), **config["wall_time_s"]}))

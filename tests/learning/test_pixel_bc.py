@@ -143,3 +143,19 @@ def test_symmetric_policy_is_equivariant():
         lp2 = pol.log_probs(o2[None]).reshape(shape)
         _, want = pixel_bc._augment(obs[0], lp[0], 1, True)
         assert np.allclose(lp2[0], want, atol=1e-4) == sym
+
+
+def test_cli_fits_on_the_device_asked(tmp_path):
+    """``--device auto`` takes CUDA where there is one and the CPU here; the config beside
+    the model says which, and the model loads on the CPU either way."""
+    import torch
+    import yaml
+
+    pixel_bc.main(
+        ["--difficulty", "easy", "--pool-size", "2", "--epochs", "1", "--width", "8",
+         "--device", "auto", "--out", str(tmp_path)]
+    )  # fmt: skip
+    cfg = yaml.safe_load((tmp_path / "final_model.yaml").read_text())
+    assert cfg["fit_device"] == ("cuda" if torch.cuda.is_available() else "cpu")
+    pol = pixel_bc.PixelPolicy.load(tmp_path / "final_model.pt")
+    assert next(pol.net.parameters()).device.type == "cpu"
