@@ -276,6 +276,8 @@ def proven_inner(
         return None
     if boundary is None:
         boundary = strips is None
+    if region.interiors:  # the pieces follow the outer ring only: cover a holed G by cells
+        boundary = False
     budget = None
     if boundary:
         cells = _boundary_cells(region, qs)

@@ -476,3 +476,33 @@ def test_the_proven_bound_needs_its_strip_obstacles(monkeypatch):
     pts = _placements(inside, inside, np.random.default_rng(5), 10)
     passes = _truth_self_occluding(scene, pts, np.random.default_rng(6))
     assert (~passes).sum() >= 3, passes
+
+
+def test_a_region_with_a_hole_is_covered_by_cells(monkeypatch):
+    """The pieces of the boundary path follow the outer ring only, so a G with a hole is
+    covered by triangles (which cover G exactly); the proven bound stays inside outer."""
+    import geometry.certify as certify
+
+    def box(x0, y0, x1, y1):
+        return [[x0, y0], [x1, y0], [x1, y1], [x0, y1]]
+
+    scene = Scene.from_dict(
+        {
+            "name": "holed-g",
+            "bounds": box(0, 0, 10, 8),
+            "obstacles": [box(1, 5, 2.5, 5.6), box(6.5, 1, 7, 2.8), box(2, 1.2, 2.6, 1.8)],
+            "target": [[-0.2, -0.15], [0.2, -0.15], [0.2, 0.15], [-0.2, 0.15]],
+            "goal": box(4, 3, 5, 4),
+            "failure": box(8, 6, 8.5, 6.5),
+        }
+    )
+    holed = shapely.Polygon(box(4, 3, 5.5, 4.5), [box(4.4, 3.4, 5.1, 4.1)[::-1]])
+
+    def no_boundary(*a, **k):
+        raise AssertionError("the boundary pieces were used for a holed region")
+
+    monkeypatch.setattr(certify, "_boundary_cells", no_boundary)
+    b = swept_bounds(scene, target_in=holed)
+    D = scene.diameter
+    assert b.proven_inner is not None and not b.proven_inner.is_empty
+    assert shapely.difference(b.proven_inner, b.outer).area <= 1e-12 * D * D
