@@ -10,7 +10,8 @@ continuous actions reached 0.10) but the whole *set* of right actions of each tr
 
 * the env is ``sensorplan/Placement-v0`` with ``obs_type="grid"``, ``grid_views=True``,
   ``self_features=True`` (channels: not free, G, H, the free space seen from G's and H's
-  anchors, field of view and reach planes) and ``action_type="pixel"`` (one action per
+  anchors, field of view and reach planes; ``--hull-views``: also the free space seen from
+  every corner of K_G and of K_H, before the planes) and ``action_type="pixel"`` (one action per
   pixel and aim, :mod:`sensorplan_gym.core.actions`), so that an output map lines up with
   the input map;
 * :func:`valid_actions` labels every pixel action of a scene by the env's own exact reward
@@ -300,6 +301,11 @@ def main(argv: list[str] | None = None) -> int:
         default=0,
         help="the pool's seed (0: the benchmark's train)",
     )
+    p.add_argument(
+        "--hull-views",
+        action="store_true",
+        help="two more channels: the free space seen from every corner of K_G and of K_H",
+    )
     p.add_argument("--epochs", type=int, default=40)
     p.add_argument("--width", type=int, default=48)
     p.add_argument("--seed", type=int, default=0)
@@ -318,6 +324,8 @@ def main(argv: list[str] | None = None) -> int:
         "scene_pool_size": a.pool_size,
         "scene_pool_seed": a.pool_seed,
     }
+    if a.hull_views:
+        pool["hull_views"] = True
     t0 = time.perf_counter()
     obs, masks = scene_data(pool, jobs=a.jobs)
     t1 = time.perf_counter()

@@ -230,6 +230,7 @@ OBSERVATION_KWARGS = (
     "self_features",
     "aim_features",
     "grid_views",
+    "hull_views",
 )
 
 

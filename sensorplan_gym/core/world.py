@@ -419,6 +419,33 @@ class World:
             self._cache[key] = out
         return self._cache[key]
 
+    def hull_view_raster(self, size: int) -> np.ndarray:
+        """``(2, size, size)`` uint8 on :meth:`raster`'s grid: 255 where a pixel's centre lies
+        in the visibility polygon of *every* vertex of K_G (channel 0) / K_H (channel 1), the
+        hulls the sensor must see (a vertex on the free space's boundary is moved 1e-9 of the
+        way towards its hull's centre), else 0: where all of a hull's corners are in view."""
+        key = f"hullviews{size}"
+        if key not in self._cache:
+            from geometry._vis import domain_from_geometry, visibility_polygon
+
+            scale, ox, oy = self.grid_transform(size)
+            ij = np.arange(size) + 0.5
+            X, Y = np.meshgrid(ox + ij / scale, oy + (size - ij) / scale)
+            dom = domain_from_geometry(self.free_space)
+            out = np.zeros((2, size, size), dtype=np.uint8)
+            for k, hull in enumerate(self.must_see):
+                seen = np.ones((size, size), dtype=bool)
+                inside = hull + 1e-9 * (hull.mean(axis=0) - hull)
+                for v in inside:
+                    if not shapely.contains_xy(self.free_space, *v):
+                        seen[:] = False  # a corner in no free space is seen from nowhere
+                        break
+                    vis = visibility_polygon(dom, np.asarray(v, dtype=np.float64))
+                    seen &= shapely.contains_xy(vis, X, Y)
+                out[k] = np.where(seen, 255, 0)
+            self._cache[key] = out
+        return self._cache[key]
+
     def grid_transform(self, size: int) -> tuple[float, float, float]:
         span = float(max(self.hi - self.lo))
         scale = size / span

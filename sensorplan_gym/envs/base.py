@@ -72,6 +72,9 @@ self_features : bool, default False -- vector observations (Navigate, Recognize,
 grid_views : bool, default False -- Placement's grid observation gets two more channels, the
     free space seen from G's and from H's anchor point (the raster twin of the vector
     observation's two scans).
+hull_views : bool, default False -- Placement's grid observation gets two more channels, the
+    free space seen from every corner of K_G and of K_H (the hulls of the target swept over G
+    and H that the sensor must see): where all of a hull's corners are in view.
 aim_features : bool, default False -- Navigate/Recognize vector observations end with the
     arcs of directions that K_G and K_H (the swept hulls) cover from the robot's pose, relative
     to its heading, and their farthest vertex's distance over the reach (see
@@ -336,6 +339,7 @@ class SensorPlanBatch(BatchSim):
         self_features: bool = False,
         aim_features: bool = False,
         grid_views: bool = False,
+        hull_views: bool = False,
         **action_kw: Any,
     ) -> None:
         for name, v in (
@@ -375,16 +379,18 @@ class SensorPlanBatch(BatchSim):
             ("self_features", self_features),
             ("aim_features", aim_features),
             ("grid_views", grid_views),
+            ("hull_views", hull_views),
         ):
             if not isinstance(v, bool):
                 raise ValueError(f"{name} must be True or False, got {v!r}")
             placement = self.obs_kind == "placement"
+            raster = name in ("grid_views", "hull_views")  # Placement's grid channels
             if (
                 not v
-                or name == "grid_views"
+                or raster
                 and placement
                 and obs_type == "grid"
-                or name != "grid_views"
+                or not raster
                 and obs_type == "vector"
                 and (not placement or name == "self_features")
                 or name == "self_features"
@@ -392,8 +398,8 @@ class SensorPlanBatch(BatchSim):
             ):
                 continue
             raise ValueError(
-                "grid_views=True needs obs_type='grid' in Placement"
-                if name == "grid_views"
+                f"{name}=True needs obs_type='grid' in Placement"
+                if raster
                 else f"{name}=True needs obs_type='vector' in Navigate or Recognize"
                 + (" (or Placement)" if name == "self_features" else "")
             )
@@ -413,6 +419,7 @@ class SensorPlanBatch(BatchSim):
             self_features=self_features,
             aim_features=aim_features,
             grid_views=grid_views,
+            hull_views=hull_views,
         )
         self.single_observation_space = self.obs.space
         self.actions = make_actions(

@@ -228,8 +228,9 @@ class PlacementEnv(SensorPlanEnv):
     ``obs_type="grid"``: ``Box(uint8, (3, S, S))``, ``S = grid_size`` (default 64), channel
     first, the bounding box fit into the square (aspect kept), row 0 at the top; channels
     0 not free (walls, obstacles, outside), 1 G, 2 H; ``grid_views=True`` adds the free space
-    seen from G's and from H's anchor, ``self_features=True`` two constant planes (field of
-    view / 360 degrees, reach / diameter, times 255).
+    seen from G's and from H's anchor, ``hull_views=True`` the free space seen from every
+    corner of K_G and of K_H, ``self_features=True`` two constant planes (field of view / 360
+    degrees, reach / diameter, times 255), in that order.
 
     ## Rewards
     ``1`` when the commanded pose distinguishes "target in G" from "target in H" under the
