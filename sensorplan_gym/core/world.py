@@ -422,8 +422,9 @@ class World:
     def hull_view_raster(self, size: int) -> np.ndarray:
         """``(2, size, size)`` uint8 on :meth:`raster`'s grid: 255 where a pixel's centre lies
         in the visibility polygon of *every* vertex of K_G (channel 0) / K_H (channel 1), the
-        hulls the sensor must see (a vertex on the free space's boundary is moved 1e-9 of the
-        way towards its hull's centre), else 0: where all of a hull's corners are in view."""
+        hulls the sensor must see, else 0: where all of a hull's corners are in view.  Each
+        vertex is moved 1e-9 of the way towards its hull's centre first; one still outside the
+        free space (a corner on a wall) is left out; a hull with none left gives 0."""
         key = f"hullviews{size}"
         if key not in self._cache:
             from geometry._vis import domain_from_geometry, visibility_polygon
@@ -434,12 +435,10 @@ class World:
             dom = domain_from_geometry(self.free_space)
             out = np.zeros((2, size, size), dtype=np.uint8)
             for k, hull in enumerate(self.must_see):
-                seen = np.ones((size, size), dtype=bool)
                 inside = hull + 1e-9 * (hull.mean(axis=0) - hull)
+                inside = inside[shapely.contains_xy(self.free_space, inside[:, 0], inside[:, 1])]
+                seen = np.full((size, size), len(inside) > 0)
                 for v in inside:
-                    if not shapely.contains_xy(self.free_space, *v):
-                        seen[:] = False  # a corner in no free space is seen from nowhere
-                        break
                     vis = visibility_polygon(dom, np.asarray(v, dtype=np.float64))
                     seen &= shapely.contains_xy(vis, X, Y)
                 out[k] = np.where(seen, 255, 0)
