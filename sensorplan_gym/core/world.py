@@ -405,18 +405,10 @@ class World:
         raster twin of the vector observation's two scans), else 0."""
         key = f"views{size}"
         if key not in self._cache:
-            from geometry._vis import domain_from_geometry, visibility_polygon
-
-            scale, ox, oy = self.grid_transform(size)
-            ij = np.arange(size) + 0.5
-            X, Y = np.meshgrid(ox + ij / scale, oy + (size - ij) / scale)
-            dom = domain_from_geometry(self.free_space)
-            out = np.zeros((2, size, size), dtype=np.uint8)
-            for k, c in enumerate((self.goal_center, self.failure_center)):
-                if shapely.contains_xy(self.free_space, *c):
-                    vis = visibility_polygon(dom, np.asarray(c, dtype=np.float64))
-                    out[k] = np.where(shapely.contains_xy(vis, X, Y), 255, 0)
-            self._cache[key] = out
+            anchors = [
+                np.asarray([c], dtype=np.float64) for c in (self.goal_center, self.failure_center)
+            ]
+            self._cache[key] = self._seen_from_all(size, anchors)
         return self._cache[key]
 
     def hull_view_raster(self, size: int) -> np.ndarray:
@@ -427,23 +419,28 @@ class World:
         free space (a corner on a wall) is left out; a hull with none left gives 0."""
         key = f"hullviews{size}"
         if key not in self._cache:
-            from geometry._vis import domain_from_geometry, visibility_polygon
-
-            scale, ox, oy = self.grid_transform(size)
-            ij = np.arange(size) + 0.5
-            X, Y = np.meshgrid(ox + ij / scale, oy + (size - ij) / scale)
-            dom = domain_from_geometry(self.free_space)
-            out = np.zeros((2, size, size), dtype=np.uint8)
-            for k, hull in enumerate(self.must_see):
-                inside = hull + 1e-9 * (hull.mean(axis=0) - hull)
-                inside = inside[shapely.contains_xy(self.free_space, inside[:, 0], inside[:, 1])]
-                seen = np.full((size, size), len(inside) > 0)
-                for v in inside:
-                    vis = visibility_polygon(dom, np.asarray(v, dtype=np.float64))
-                    seen &= shapely.contains_xy(vis, X, Y)
-                out[k] = np.where(seen, 255, 0)
-            self._cache[key] = out
+            corners = [h + 1e-9 * (h.mean(axis=0) - h) for h in self.must_see]
+            self._cache[key] = self._seen_from_all(size, corners)
         return self._cache[key]
+
+    def _seen_from_all(self, size: int, groups: list[np.ndarray]) -> np.ndarray:
+        """``(len(groups), size, size)`` uint8: 255 where a pixel's centre lies in the
+        visibility polygon of every point of group k that is in the free space (the others
+        are left out; a group with none left gives 0)."""
+        from geometry._vis import domain_from_geometry, visibility_polygon
+
+        scale, ox, oy = self.grid_transform(size)
+        ij = np.arange(size) + 0.5
+        X, Y = np.meshgrid(ox + ij / scale, oy + (size - ij) / scale)
+        dom = domain_from_geometry(self.free_space)
+        out = np.zeros((len(groups), size, size), dtype=np.uint8)
+        for k, pts in enumerate(groups):
+            pts = pts[shapely.contains_xy(self.free_space, pts[:, 0], pts[:, 1])]
+            seen = np.full((size, size), len(pts) > 0)
+            for v in pts:
+                seen &= shapely.contains_xy(visibility_polygon(dom, v), X, Y)
+            out[k] = np.where(seen, 255, 0)
+        return out
 
     def grid_transform(self, size: int) -> tuple[float, float, float]:
         span = float(max(self.hi - self.lo))
