@@ -30,10 +30,11 @@ from . import _results
 from .fuzz_contacts import summary
 
 
-def _chunk(arg: tuple[int, int, str]) -> str:
-    """Fuzz one chunk (``n`` seeds from ``seed``) and write its summary to ``path``."""
-    seed, n, path = arg
-    res = run_many(n, seed=seed, swept=True, contacts=True, frames=True)
+def _chunk(arg: tuple[int, int, str, bool]) -> str:
+    """Fuzz one chunk (``n`` seeds from ``seed``; with the certified bounds if ``certify``)
+    and write its summary to ``path``."""
+    seed, n, path, certify = arg
+    res = run_many(n, seed=seed, swept=True, contacts=True, frames=True, certify=certify)
     tmp = Path(path).with_suffix(".tmp")
     tmp.write_text(json.dumps(res, indent=1) + "\n", encoding="utf-8")
     tmp.replace(path)  # a chunk file is whole or absent
@@ -68,9 +69,12 @@ def merge(paths: list[Path]) -> dict[str, Any]:
     }
 
 
-def main(argv: list[str] | None = None) -> None:
+def main(argv: list[str] | None = None, *, name: str = "fuzz_swept", doc: str = "") -> None:
+    """Run the chunks and write the merged data as ``name`` (``fuzz_certify``: with the
+    certified bounds of :func:`geometry.certify.swept_bounds` on every scene)."""
+    certify = name == "fuzz_certify"
     ap = argparse.ArgumentParser(
-        prog="python -m benchmarks.fuzz_swept", description=__doc__.split("\n\n")[0]
+        prog=f"python -m benchmarks.{name}", description=(doc or __doc__).split("\n\n")[0]
     )
     ap.add_argument("--n", type=int, default=10_200, help="number of seeds")
     ap.add_argument("--seed", type=int, default=200_000, help="first seed")
@@ -79,19 +83,19 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument(
         "--chunks",
         type=Path,
-        default=_results.DEFAULT_OUT / "fuzz_swept" / "chunks",
+        default=_results.DEFAULT_OUT / name / "chunks",
         help="folder of the chunk summaries (kept; a rerun skips the chunks there)",
     )
-    _results.add_output_args(ap, "fuzz_swept")
+    _results.add_output_args(ap, name)
     args = ap.parse_args(argv)
-    for name in ("n", "chunk", "jobs"):
-        if getattr(args, name) < 1:
-            ap.error(f"--{name} must be a positive integer, got {getattr(args, name)}")
+    for opt in ("n", "chunk", "jobs"):
+        if getattr(args, opt) < 1:
+            ap.error(f"--{opt} must be a positive integer, got {getattr(args, opt)}")
     args.chunks.mkdir(parents=True, exist_ok=True)
     starts = range(args.seed, args.seed + args.n, args.chunk)
     paths = [args.chunks / f"chunk_{s}.json" for s in starts]
     todo = [
-        (s, min(args.chunk, args.seed + args.n - s), str(p))
+        (s, min(args.chunk, args.seed + args.n - s), str(p), certify)
         for s, p in zip(starts, paths, strict=True)
         if not p.exists()
     ]
@@ -101,13 +105,13 @@ def main(argv: list[str] | None = None) -> None:
             for done in ex.map(_chunk, todo):
                 print("wrote", done, flush=True)
     data: dict[str, Any] = {
-        "command": _results.command("benchmarks.fuzz_swept", argv),
+        "command": _results.command(f"benchmarks.{name}", argv),
         "machine": _results.machine(),
         "seeds": [args.seed, args.seed + args.n - 1],
         "chunk": args.chunk,
         **merge(paths),
     }
-    _results.write("fuzz_swept", data, args.out, args.update_results)
+    _results.write(name, data, args.out, args.update_results)
 
 
 def render(data: dict[str, Any]) -> str:

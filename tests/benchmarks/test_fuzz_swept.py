@@ -58,3 +58,15 @@ def test_merge_counts_violations_and_failing_seeds(tmp_path):
 def test_bad_arguments_fail_clearly():
     with pytest.raises(SystemExit):
         fuzz_swept.main(["--chunk", "0"])
+
+
+def test_certify_variant_writes_its_own_result(tmp_path):
+    from benchmarks import fuzz_certify
+
+    chunks, out = tmp_path / "chunks", tmp_path / "out"
+    fuzz_certify.main(["--n", "1", "--seed", "300001", "--chunks", str(chunks), "--out", str(out)])
+    data = json.loads((out / "fuzz_certify.json").read_text())
+    part = json.loads((chunks / "chunk_300001.json").read_text())
+    assert "swept bounds" in part["slowest_query_s"]  # the certified bounds ran
+    assert data["violations"] == {} and data["valid"] == 1
+    assert "python -m benchmarks.fuzz_certify --n 1" in (out / "fuzz_certify.md").read_text()
