@@ -11,7 +11,9 @@ continuous actions reached 0.10) but the whole *set* of right actions of each tr
 * the env is ``sensorplan/Placement-v0`` with ``obs_type="grid"``, ``grid_views=True``,
   ``self_features=True`` (channels: not free, G, H, the free space seen from G's and H's
   anchors, field of view and reach planes; ``--hull-views``: also the free space seen from
-  every corner of K_G and of K_H, before the planes) and ``action_type="pixel"`` (one action per
+  every corner of K_G and of K_H, before the planes; ``--aim-views``: then one channel per aim,
+  where that aim passes the reward's aim test, which the symmetries permute like the actions'
+  aims) and ``action_type="pixel"`` (one action per
   pixel and aim, :mod:`sensorplan_gym.core.actions`), so that an output map lines up with
   the input map;
 * :func:`valid_actions` labels every pixel action of a scene by the env's own exact reward
@@ -43,7 +45,16 @@ import torch
 import yaml
 from torch import nn
 
-__all__ = ["ENV_ID", "ENV_KWARGS", "PixelNet", "PixelPolicy", "fit", "scene_data", "valid_actions"]
+__all__ = [
+    "ENV_ID",
+    "ENV_KWARGS",
+    "PixelNet",
+    "PixelPolicy",
+    "aim_channels",
+    "fit",
+    "scene_data",
+    "valid_actions",
+]
 
 ENV_ID = "sensorplan/Placement-v0"
 
@@ -132,18 +143,46 @@ class PixelNet(nn.Module):
         return self.head(torch.relu(x)).permute(0, 2, 3, 1).reshape(b, -1)  # (B, S*S*A)
 
 
+def aim_channels(env_kwargs: dict[str, Any]) -> tuple[int, int] | None:
+    """The channels ``[lo, hi)`` of the ``aim_views`` planes in the grid observation that
+    ``env_kwargs`` (with :data:`ENV_KWARGS`) makes, or ``None`` without them (the order of
+    :class:`sensorplan_gym.core.observations.PlacementGridObs`)."""
+    kw = {**env_kwargs, **ENV_KWARGS}
+    if not kw.get("aim_views"):
+        return None
+    lo = 3 + 2 * bool(kw.get("grid_views")) + 2 * bool(kw.get("hull_views"))
+    return lo, lo + int(kw["placement_aims"])
+
+
+def _turn(obs: np.ndarray, k: int, flip: bool, aim: tuple[int, int] | None) -> np.ndarray:
+    """Observations ``(..., C, S, S)`` turned ``k`` quarter turns counter-clockwise, then
+    mirrored left-right if ``flip``; the aim planes ``aim`` (channels ``[lo, hi)``, one per
+    aim) are permuted as the actions' aims are (a quarter turn adds ``A / 4``, the mirror maps
+    ``k`` to ``A / 2 - k``)."""
+    o = np.rot90(obs, k, axes=(-2, -1))
+    if flip:
+        o = o[..., ::-1]
+    if aim is not None:
+        lo, hi = aim
+        a = hi - lo
+        perm = (np.arange(a) - k * a // 4) % a  # plane j of the turned scene is plane j - kA/4
+        if flip:
+            perm = perm[(a // 2 - np.arange(a)) % a]
+        o = np.concatenate([o[..., :lo, :, :], o[..., lo + perm, :, :], o[..., hi:, :, :]], -3)
+    return np.ascontiguousarray(o)
+
+
 def _augment(
-    obs: np.ndarray, mask: np.ndarray, k: int, flip: bool
+    obs: np.ndarray, mask: np.ndarray, k: int, flip: bool, aim: tuple[int, int] | None = None
 ) -> tuple[np.ndarray, np.ndarray]:
     """The scene turned ``k`` quarter turns counter-clockwise, then mirrored left-right if
-    ``flip``: observation ``(C, S, S)`` and mask ``(S, S, A)`` alike (aims follow)."""
+    ``flip``: observation ``(C, S, S)`` (:func:`_turn`; ``aim``: its aim planes) and mask
+    ``(S, S, A)`` alike (aims follow)."""
     a = mask.shape[-1]
-    o = np.rot90(obs, k, axes=(1, 2))
     m = np.roll(np.rot90(mask, k, axes=(0, 1)), k * a // 4, axis=2)
     if flip:
-        o = o[:, :, ::-1]
         m = m[:, ::-1, (a // 2 - np.arange(a)) % a]
-    return np.ascontiguousarray(o), np.ascontiguousarray(m)
+    return _turn(obs, k, flip, aim), np.ascontiguousarray(m)
 
 
 def set_nll(logits: torch.Tensor, valid: torch.Tensor) -> torch.Tensor:
@@ -165,12 +204,14 @@ def fit(
     augment: bool = True,
     log: Any = print,
     device: str = "cpu",
+    aim: tuple[int, int] | None = None,
 ) -> PixelNet:
     """A :class:`PixelNet` trained on the scenes ``obs`` ``(N, C, S, S)`` with valid-action
     masks ``masks`` ``(N, S, S, A)`` (scenes with no valid action are skipped): Adam with a
     cosine schedule, the set likelihood :func:`set_nll`, a random symmetry of the square per
     sample and epoch when ``augment``.  ``device``: where to train (a torch device name,
-    e.g. ``"cuda"``; the same draws on every device); the net is returned on the CPU."""
+    e.g. ``"cuda"``; the same draws on every device); the net is returned on the CPU.
+    ``aim``: the observation's aim planes (:func:`aim_channels`), permuted by the symmetries."""
     torch.manual_seed(seed)
     rng = np.random.default_rng(seed)
     keep = masks.reshape(len(masks), -1).any(axis=1)
@@ -186,7 +227,7 @@ def fit(
             rows = order[s : s + batch_size]
             if augment:
                 pairs = [
-                    _augment(obs[r], masks[r], int(rng.integers(4)), bool(rng.integers(2)))
+                    _augment(obs[r], masks[r], int(rng.integers(4)), bool(rng.integers(2)), aim)
                     for r in rows
                 ]
                 o = np.stack([p[0] for p in pairs])
@@ -224,9 +265,16 @@ class PixelPolicy:
     hard level's 64 test-pool scenes (each once), and 0.77 against 0.79 on the benchmark's 100
     test episodes (52 distinct scenes): no difference the samples can tell."""
 
-    def __init__(self, net: PixelNet, *, symmetries: bool = True) -> None:
+    def __init__(
+        self,
+        net: PixelNet,
+        *,
+        symmetries: bool = True,
+        aim: tuple[int, int] | None = None,
+    ) -> None:
         self.net = net.eval()
         self.symmetries = bool(symmetries)
+        self.aim = None if aim is None else (int(aim[0]), int(aim[1]))
 
     def log_probs(self, obs: np.ndarray) -> np.ndarray:
         """``(B, S * S * A)`` log-probabilities of the pixel actions for observations ``(B, C,
@@ -237,10 +285,8 @@ class PixelPolicy:
         acc = np.zeros((b, s, s, a))
         with torch.no_grad():
             for k, flip in views:
-                o = np.rot90(obs, k, axes=(2, 3))
-                if flip:
-                    o = o[:, :, :, ::-1]
-                lp = torch.log_softmax(self.net(torch.from_numpy(np.ascontiguousarray(o))), dim=1)
+                o = _turn(obs, k, bool(flip), self.aim)
+                lp = torch.log_softmax(self.net(torch.from_numpy(o)), dim=1)
                 acc += _untransform(lp.numpy().reshape(b, s, s, a), k, bool(flip))
         return (acc / len(views)).reshape(b, -1)
 
@@ -273,6 +319,7 @@ class PixelPolicy:
             "channels": int(self.net.stem.in_channels - 2),
             "aims": int(head.out_channels),
             "width": int(head.in_channels),
+            "aim_channels": None if self.aim is None else list(self.aim),
         }
         torch.save({"state_dict": self.net.state_dict(), "shape": shape}, path)
         with open(path.with_suffix(".yaml"), "w") as f:
@@ -286,7 +333,8 @@ class PixelPolicy:
         shape = got["shape"]
         net = PixelNet(shape["channels"], shape["aims"], width=shape["width"])
         net.load_state_dict(got["state_dict"])
-        return cls(net)
+        aim = shape.get("aim_channels")
+        return cls(net, aim=None if aim is None else (aim[0], aim[1]))
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -305,6 +353,11 @@ def main(argv: list[str] | None = None) -> int:
         "--hull-views",
         action="store_true",
         help="two more channels: the free space seen from every corner of K_G and of K_H",
+    )
+    p.add_argument(
+        "--aim-views",
+        action="store_true",
+        help="one more channel per aim: where that aim passes the reward's aim test",
     )
     p.add_argument("--epochs", type=int, default=40)
     p.add_argument("--width", type=int, default=48)
@@ -326,6 +379,9 @@ def main(argv: list[str] | None = None) -> int:
     }
     if a.hull_views:
         pool["hull_views"] = True
+    if a.aim_views:
+        pool["aim_views"] = True
+    aim = aim_channels(pool)
     t0 = time.perf_counter()
     obs, masks = scene_data(pool, jobs=a.jobs)
     t1 = time.perf_counter()
@@ -336,7 +392,7 @@ def main(argv: list[str] | None = None) -> int:
     device = a.device
     if device == "auto":
         device = "cuda" if torch.cuda.is_available() else "cpu"
-    net = fit(obs, masks, epochs=a.epochs, seed=a.seed, width=a.width, device=device)
+    net = fit(obs, masks, epochs=a.epochs, seed=a.seed, width=a.width, device=device, aim=aim)
     t2 = time.perf_counter()
     config = {
         "env_id": ENV_ID,
@@ -350,7 +406,7 @@ def main(argv: list[str] | None = None) -> int:
         "wall_time_s": {"label": round(t1 - t0, 1), "fit": round(t2 - t1, 1)},
         "fit_device": device,
     }
-    path = PixelPolicy(net).save(Path(a.out) / "final_model.pt", config)
+    path = PixelPolicy(net, aim=aim).save(Path(a.out) / "final_model.pt", config)
     print(json.dumps({"model": str(path), **config["wall_time_s"]}))
     return 0
 

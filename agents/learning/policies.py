@@ -231,6 +231,7 @@ OBSERVATION_KWARGS = (
     "aim_features",
     "grid_views",
     "hull_views",
+    "aim_views",
 )
 
 

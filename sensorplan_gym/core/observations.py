@@ -317,9 +317,10 @@ class PlacementGridObs:
     """``Box(uint8, (C, S, S))`` on the scene raster (:meth:`World.raster`): channels not
     free, G, H; with ``views`` two more, the free space seen from G's and from H's anchor
     (:meth:`World.view_raster`); with ``hull_views`` two more, the free space seen from every
-    corner of K_G and of K_H (:meth:`World.hull_view_raster`); with ``self_features`` two
-    constant planes, the field of view over 360 degrees and the reach over the diameter,
-    times 255 (in that order)."""
+    corner of K_G and of K_H (:meth:`World.hull_view_raster`); with ``aim_views`` (a number
+    of aims A) A more, where aim ``k`` passes the reward's aim test (:meth:`World.aim_raster`);
+    with ``self_features`` two constant planes, the field of view over 360 degrees and the
+    reach over the diameter, times 255 (in that order)."""
 
     def __init__(
         self,
@@ -329,6 +330,7 @@ class PlacementGridObs:
         views: bool = False,
         self_features: bool = False,
         hull_views: bool = False,
+        aim_views: int = 0,
     ) -> None:
         if grid_size < 36:
             raise ValueError(f"grid_size must be >= 36 (CnnPolicy's NatureCNN), got {grid_size}")
@@ -336,11 +338,14 @@ class PlacementGridObs:
         self.views = bool(views)
         self.hull_views = bool(hull_views)
         self.self_features = bool(self_features)
-        self.channels = 3 + 2 * self.views + 2 * self.hull_views + 2 * self.self_features
+        self.aim_views = int(aim_views)
+        self.channels = (
+            3 + 2 * self.views + 2 * self.hull_views + self.aim_views + 2 * self.self_features
+        )
         self.space = spaces.Box(0, 255, (self.channels, self.size, self.size), dtype=np.uint8)
 
     def __call__(self, sim: BatchSim, idx: np.ndarray) -> np.ndarray:
-        if not (self.views or self.hull_views or self.self_features):
+        if not (self.views or self.hull_views or self.aim_views or self.self_features):
             return np.broadcast_to(
                 _rasters(sim, idx, self.size), (len(idx), *self.space.shape)
             ).copy()
@@ -352,7 +357,7 @@ class PlacementGridObs:
 
     def of_world(self, world: World) -> np.ndarray:
         """The (constant) observation of one world, computed once."""
-        flags = f"{int(self.views)}{int(self.hull_views)}{int(self.self_features)}"
+        flags = f"{int(self.views)}{int(self.hull_views)}{self.aim_views}{int(self.self_features)}"
         key = f"placement_grid{self.size}_{flags}"
         got = world._cache.get(key)
         if got is None:
@@ -361,6 +366,8 @@ class PlacementGridObs:
                 parts.append(world.view_raster(self.size))
             if self.hull_views:
                 parts.append(world.hull_view_raster(self.size))
+            if self.aim_views:
+                parts.append(world.aim_raster(self.size, self.aim_views))
             if self.self_features:
                 fov = world.fov / (2.0 * math.pi)
                 reach = min(world.max_range / world.diameter, 1.0)
@@ -385,13 +392,14 @@ def make_observation(
     aim_features: bool = False,
     grid_views: bool = False,
     hull_views: bool = False,
+    aim_views: int = 0,
 ):
     """The observation builder for env ``kind`` ("robot" or "placement") and ``obs_type``;
     ``map_ranges`` / ``map_evidence`` / ``sensor_fov`` / ``self_features``: robot vector
     observations carry the map-predicted ranges / the per-beam evidence flags / the field of
     view / the field of view and the reach too / the arcs of K_G and K_H (:func:`aim_features`);
-    Placement's grid: ``grid_views`` / ``hull_views`` / ``self_features`` add channels
-    (:class:`PlacementGridObs`)."""
+    Placement's grid: ``grid_views`` / ``hull_views`` / ``aim_views`` (a number of aims) /
+    ``self_features`` add channels (:class:`PlacementGridObs`)."""
     if obs_type not in OBS_TYPES:
         raise ValueError(f"obs_type must be one of {OBS_TYPES}, got {obs_type!r}")
     table = {
@@ -402,10 +410,15 @@ def make_observation(
     }
     if kind == "placement" and obs_type == "grid":
         return PlacementGridObs(
-            n_beams, grid_size, views=grid_views, self_features=self_features, hull_views=hull_views
+            n_beams,
+            grid_size,
+            views=grid_views,
+            self_features=self_features,
+            hull_views=hull_views,
+            aim_views=aim_views,
         )
-    if grid_views or hull_views:
-        name = "grid_views" if grid_views else "hull_views"
+    if grid_views or hull_views or aim_views:
+        name = "grid_views" if grid_views else "hull_views" if hull_views else "aim_views"
         raise ValueError(f"{name}=True needs obs_type='grid' in Placement")
     if kind == "placement" and self_features:
         return PlacementVectorObs(n_beams, grid_size, self_features=True)

@@ -423,6 +423,34 @@ class World:
             self._cache[key] = self._seen_from_all(size, corners)
         return self._cache[key]
 
+    def aim_raster(self, size: int, aims: int) -> np.ndarray:
+        """``(aims, size, size)`` uint8 on :meth:`raster`'s grid: 255 where the sensor at a
+        pixel's centre, aimed at ``-pi + 2 pi k / aims`` radians (channel ``k``: the pixel
+        action's aim ``k``), passes the aim test of the reward (:meth:`aim_ok`: K_G and K_H
+        inside the field of view with the ``eps_aim`` / ``eps_pos`` margins, and within
+        ``max_range``), else 0.  Occlusion is not part of it (:meth:`hull_view_raster`)."""
+        key = f"aims{size}_{aims}"
+        if key not in self._cache:
+            scale, ox, oy = self.grid_transform(size)
+            ij = np.arange(size) + 0.5
+            X, Y = np.meshgrid(ox + ij / scale, oy + (size - ij) / scale)
+            psi = math.pi * (-1.0 + 2.0 * np.arange(aims) / aims)
+            n = size * size
+            r = self.batch_rows()
+            ok = aim_ok_batch(
+                np.tile(X.ravel(), aims),
+                np.tile(Y.ravel(), aims),
+                np.repeat(psi, n),
+                r["hulls"][None],
+                r["centers"][None],
+                fov=self.fov,
+                eps_aim=self.eps_aim,
+                eps_pos=self.eps_pos,
+                max_range=self.max_range,
+            )
+            self._cache[key] = np.where(ok.reshape(aims, size, size), 255, 0).astype(np.uint8)
+        return self._cache[key]
+
     def _seen_from_all(self, size: int, groups: list[np.ndarray]) -> np.ndarray:
         """``(len(groups), size, size)`` uint8: 255 where a pixel's centre lies in the
         visibility polygon of every point of group k that is in the free space (the others

@@ -75,6 +75,10 @@ grid_views : bool, default False -- Placement's grid observation gets two more c
 hull_views : bool, default False -- Placement's grid observation gets two more channels, the
     free space seen from every corner of K_G and of K_H (the hulls of the target swept over G
     and H that the sensor must see): where all of a hull's corners are in view.
+aim_views : bool, default False -- Placement's grid observation gets ``placement_aims`` more
+    channels, one per aim of the Placement actions: where that aim from the pixel's centre keeps
+    K_G and K_H in the field of view (with the aim and position margins) and within range, the
+    angular half of the reward's test (occlusion is the other).
 aim_features : bool, default False -- Navigate/Recognize vector observations end with the
     arcs of directions that K_G and K_H (the swept hulls) cover from the robot's pose, relative
     to its heading, and their farthest vertex's distance over the reach (see
@@ -340,6 +344,7 @@ class SensorPlanBatch(BatchSim):
         aim_features: bool = False,
         grid_views: bool = False,
         hull_views: bool = False,
+        aim_views: bool = False,
         **action_kw: Any,
     ) -> None:
         for name, v in (
@@ -380,11 +385,12 @@ class SensorPlanBatch(BatchSim):
             ("aim_features", aim_features),
             ("grid_views", grid_views),
             ("hull_views", hull_views),
+            ("aim_views", aim_views),
         ):
             if not isinstance(v, bool):
                 raise ValueError(f"{name} must be True or False, got {v!r}")
             placement = self.obs_kind == "placement"
-            raster = name in ("grid_views", "hull_views")  # Placement's grid channels
+            raster = name in ("grid_views", "hull_views", "aim_views")  # Placement's grid
             if (
                 not v
                 or raster
@@ -420,6 +426,7 @@ class SensorPlanBatch(BatchSim):
             aim_features=aim_features,
             grid_views=grid_views,
             hull_views=hull_views,
+            aim_views=int(action_kw.get("placement_aims", 8)) if aim_views else 0,
         )
         self.single_observation_space = self.obs.space
         self.actions = make_actions(

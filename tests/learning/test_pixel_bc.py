@@ -44,16 +44,26 @@ def _turned(d: dict, k: int, flip: bool) -> dict:
     return out
 
 
-@pytest.mark.parametrize(("k", "flip"), [(1, False), (2, True)])
-def test_augmentation_is_the_labels_of_the_turned_scene(k, flip):
+@pytest.mark.parametrize(("k", "flip", "aims"), [(1, False, False), (2, True, False),
+                                               (1, True, True), (3, False, True)])  # fmt: skip
+def test_augmentation_is_the_labels_of_the_turned_scene(k, flip, aims):
     """A symmetry of the square applied to a scene's observation and valid-action mask (the
     aims follow: a quarter turn adds A / 4, a mirror maps aim k to A / 2 - k) equals the
-    observation and the exact labels of the scene turned the same way."""
+    observation and the exact labels of the scene turned the same way; with ``aim_views``
+    the aim planes are permuted like the aims."""
     d = json.loads((SCENES / "edr.json").read_text())
     d["sensor"] = {**d["sensor"], "fov_deg": 120}
-    o0, m0 = pixel_bc.scene_data({"scene": d})
-    o1, m1 = pixel_bc.scene_data({"scene": _turned(d, k, flip)})
-    oa, ma = pixel_bc._augment(o0[0], m0[0], k, flip)
+    extra = {"aim_views": True, "hull_views": True} if aims else {}
+    aim = pixel_bc.aim_channels(extra)
+    assert (aim is not None) == aims
+    o0, m0 = pixel_bc.scene_data({"scene": d, **extra})
+    o1, m1 = pixel_bc.scene_data({"scene": _turned(d, k, flip), **extra})
+    oa, ma = pixel_bc._augment(o0[0], m0[0], k, flip, aim)
+    if aims:
+        lo, hi = aim
+        assert hi - lo == m0.shape[-1] == 16 and o0.shape[1] == hi + 2
+        assert 0 < (oa[lo:hi] > 0).mean() < 0.9
+        assert (oa[lo:hi] != o1[0, lo:hi]).mean() < 0.01
     assert 0 < m0.sum() < m0.size // 4
     # pixel centres on a region's edge can go either way after the turn's rounding
     assert (ma != m1[0]).mean() < 2e-4
@@ -129,17 +139,21 @@ def test_evaluate_loads_a_pixel_policy(tmp_path):
         check_policies([str(bare)])
 
 
-def test_symmetric_policy_is_equivariant():
+@pytest.mark.parametrize("aims", [False, True])
+def test_symmetric_policy_is_equivariant(aims):
     """With ``symmetries`` the policy's log-probabilities of a turned and mirrored scene are
-    the scene's own, turned and mirrored (aims too); without, a fresh net is not."""
-    obs, masks = pixel_bc.scene_data({"scene": "edr", "grid_size": 40})
+    the scene's own, turned and mirrored (aims too, and the aim planes with them); without, a
+    fresh net is not."""
+    extra = {"aim_views": True, "fov_deg": 90.0} if aims else {}
+    aim = pixel_bc.aim_channels(extra)
+    obs, masks = pixel_bc.scene_data({"scene": "edr", "grid_size": 40, **extra})
     torch.manual_seed(0)
     net = pixel_bc.PixelNet(obs.shape[1], masks.shape[-1], width=8)
     shape = masks.shape  # (1, S, S, A)
     for sym in (True, False):
-        pol = pixel_bc.PixelPolicy(net, symmetries=sym)
+        pol = pixel_bc.PixelPolicy(net, symmetries=sym, aim=aim)
         lp = pol.log_probs(obs).reshape(shape)
-        o2, _ = pixel_bc._augment(obs[0], masks[0], 1, True)
+        o2, _ = pixel_bc._augment(obs[0], masks[0], 1, True, aim)
         lp2 = pol.log_probs(o2[None]).reshape(shape)
         _, want = pixel_bc._augment(obs[0], lp[0], 1, True)
         assert np.allclose(lp2[0], want, atol=1e-4) == sym
@@ -153,9 +167,11 @@ def test_cli_fits_on_the_device_asked(tmp_path):
 
     pixel_bc.main(
         ["--difficulty", "easy", "--pool-size", "2", "--epochs", "1", "--width", "8",
-         "--device", "auto", "--out", str(tmp_path)]
+         "--device", "auto", "--aim-views", "--out", str(tmp_path)]
     )  # fmt: skip
     cfg = yaml.safe_load((tmp_path / "final_model.yaml").read_text())
     assert cfg["fit_device"] == ("cuda" if torch.cuda.is_available() else "cpu")
+    assert cfg["env_kwargs"]["aim_views"] is True and cfg["net"]["aim_channels"] == [5, 21]
     pol = pixel_bc.PixelPolicy.load(tmp_path / "final_model.pt")
     assert next(pol.net.parameters()).device.type == "cpu"
+    assert pol.aim == (5, 21)
