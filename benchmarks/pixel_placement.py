@@ -10,7 +10,13 @@ seeds.  ``test`` is the held-out pool of the level (seed 1; the policies were tr
 of seed 0); ``ood`` and ``real`` the bundled and real maps, each one
 scene with its own sensor, so that a deterministic policy plays one decision there.  The
 policy's training record (labelling and fitting time, the share of training scenes with a
-right pixel action) comes from the config beside the model.  Needs the ``rl`` extra.
+right pixel action) comes from the config beside the model.
+
+A second table plays every scene once, by the exact labels of all its pixel actions
+(:func:`agents.learning.pixel_bc.scene_data`): the 64 scenes of the test pool, the bundled and
+the real maps, for the pixel policy and for :func:`agents.learning.pixel_bc.channel_rule`, a
+fixed rule on the ``hull_views`` and ``aim_views`` channels (no learning), so that what the
+learned net adds to those channels can be read off.  Needs the ``rl`` extra.
 """
 
 from __future__ import annotations
@@ -54,6 +60,7 @@ def main(argv: list[str] | None = None) -> int:
             out=tmp,
             verbose=False,
         )
+    scenes = per_scene(args.model)
     names = {str(args.model): "pixel policy", str(PPO): "PPO (ppo_placement_random)"}
     rows = []
     for split, r in res["splits"].items():
@@ -77,11 +84,55 @@ def main(argv: list[str] | None = None) -> int:
             for k in ("command", "labelled_scenes", "solvable_fraction", "epochs", "wall_time_s")
         },
         "rows": rows,
+        "scenes": scenes,
         "seconds": round(time.perf_counter() - t0, 1),
     }
     _results.write("pixel_placement", data, args.out, args.update_results)
     print(render(data))
     return 0
+
+
+#: the procedural split of :func:`per_scene`: the hard level's test pool, every scene once
+TEST_POOL = {"scene": "random", "difficulty": "hard", "scene_pool_seed": 1, "scene_pool_size": 64}
+
+
+def per_scene(model: Path) -> list[dict[str, Any]]:
+    """Rows ``{split, scenes, solvable, policy, rule}``: of the ``scenes`` of each split,
+    how many have a right pixel action, how many the pixel policy ``model`` gets right and how
+    many :func:`~agents.learning.pixel_bc.channel_rule` does, each scene played once."""
+    import numpy as np
+
+    from agents.learning import pixel_bc
+    from agents.learning.policies import model_config, play_env_kwargs
+    from sensorplan_gym import BUNDLED_SCENES, REAL_SCENES
+
+    policy = pixel_bc.PixelPolicy.load(model)
+    cfg = model_config(model) or {}
+    views = {"hull_views": True, "aim_views": True}
+    aim = pixel_bc.aim_channels(views)
+    splits = {"test": TEST_POOL}
+    splits.update({f"ood:{s}": {"scene": s} for s in BUNDLED_SCENES})
+    splits.update({f"real:{s[5:]}": {"scene": s} for s in REAL_SCENES})
+    rows = []
+    for name, kw in splits.items():
+        obs_r, masks = pixel_bc.scene_data({**kw, **views})
+        play = play_env_kwargs(cfg, kw)
+        same = all(play.get(k) == v for k, v in views.items())
+        obs_m = obs_r if same else pixel_bc.scene_data(play)[0]
+        flat = masks.reshape(len(masks), -1)
+        at = np.arange(len(flat))
+        got = flat[at, policy.predict(obs_m)[0]]
+        rule = flat[at, pixel_bc.channel_rule(obs_r, aim)]
+        rows.append(
+            {
+                "split": name,
+                "scenes": len(flat),
+                "solvable": int(flat.any(axis=1).sum()),
+                "policy": int(got.sum()),
+                "rule": int(rule.sum()),
+            }
+        )
+    return rows
 
 
 def render(data: dict[str, Any]) -> str:
@@ -104,6 +155,19 @@ def render(data: dict[str, Any]) -> str:
             cells.append(f"{r['successes'] / r['episodes']:.2f} [{lo:.2f}, {hi:.2f}]")
         d = next(by[(s, p)]["distinct"] for p in order if (s, p) in by)
         lines.append(f"| {s} | " + " | ".join(cells) + f" | {d} |")
+    if data.get("scenes"):
+        lines += [
+            "",
+            "Each scene played once, scored by the exact labels of all its pixel actions:",
+            "",
+            "| split | scenes | with a right pixel action | pixel policy | channel rule "
+            "(no learning) |",
+            "|---|---|---|---|---|",
+        ]
+        for r in data["scenes"]:
+            lines.append(
+                f"| {r['split']} | {r['scenes']} | {r['solvable']} | {r['policy']} | {r['rule']} |"
+            )
     t = data["training"]
     wall = t.get("wall_time_s") or {}
     lines += [

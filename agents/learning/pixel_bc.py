@@ -51,6 +51,7 @@ __all__ = [
     "PixelNet",
     "PixelPolicy",
     "aim_channels",
+    "channel_rule",
     "fit",
     "scene_data",
     "valid_actions",
@@ -335,6 +336,36 @@ class PixelPolicy:
         net.load_state_dict(got["state_dict"])
         aim = shape.get("aim_channels")
         return cls(net, aim=None if aim is None else (aim[0], aim[1]))
+
+
+def channel_rule(obs: np.ndarray, aim: tuple[int, int]) -> np.ndarray:
+    """The pixel actions ``(B,)`` of a fixed rule on grid observations ``(B, C, S, S)`` made
+    with ``hull_views`` and ``aim_views`` (``aim``: the aim planes, :func:`aim_channels`):
+    among the pixels that are free and see every corner of K_G and of K_H, and the aims that
+    pass the aim test there, the pixel deepest inside that seen set (Euclidean distance
+    transform, in pixels) with the aim farthest from a failing aim.  No learning: a baseline
+    for what those channels give by themselves.  A scene with no such pixel gets action 0."""
+    from scipy import ndimage
+
+    lo, hi = aim
+    a = hi - lo
+    hv = lo - 2  # the hull views precede the aim planes
+    b, _, s, _ = obs.shape
+    out = np.zeros(b, dtype=np.int64)
+    for i in range(b):
+        seen = (obs[i, 0] == 0) & (obs[i, hv] > 0) & (obs[i, hv + 1] > 0)
+        ok = (obs[i, lo:hi] > 0) & seen[None]  # (A, S, S)
+        if not ok.any():
+            continue
+        run = ok.astype(np.float64)  # how far each passing aim is from a failing one
+        both = ok.copy()
+        for d in range(1, a // 2 + 1):
+            both &= np.roll(ok, d, axis=0) & np.roll(ok, -d, axis=0)
+            run += both
+        score = np.where(ok, ndimage.distance_transform_edt(seen)[None] * (a + 1) + run, -1.0)
+        k, r, c = np.unravel_index(int(np.argmax(score)), score.shape)
+        out[i] = (r * s + c) * a + k
+    return out
 
 
 def main(argv: list[str] | None = None) -> int:

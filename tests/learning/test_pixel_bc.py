@@ -175,3 +175,18 @@ def test_cli_fits_on_the_device_asked(tmp_path):
     pol = pixel_bc.PixelPolicy.load(tmp_path / "final_model.pt")
     assert next(pol.net.parameters()).device.type == "cpu"
     assert pol.aim == (5, 21)
+
+
+def test_channel_rule_plays_right_actions_from_the_channels():
+    """The fixed rule over the hull-view and aim planes picks a right action on the bundled
+    scenes (every right action there sees both hulls' corners), and action 0 where no pixel
+    qualifies."""
+    kw = {"hull_views": True, "aim_views": True}
+    aim = pixel_bc.aim_channels(kw)
+    for scene in ("lab", "edr"):
+        obs, masks = pixel_bc.scene_data({"scene": scene, **kw})
+        act = pixel_bc.channel_rule(obs, aim)
+        assert masks.reshape(1, -1)[0, act[0]]
+    blank = obs.copy()
+    blank[:, aim[0] : aim[1]] = 0
+    assert pixel_bc.channel_rule(blank, aim).tolist() == [0]
