@@ -232,6 +232,7 @@ OBSERVATION_KWARGS = (
     "grid_views",
     "hull_views",
     "aim_views",
+    "view_hint",
 )
 
 

@@ -54,6 +54,7 @@ import math
 from typing import TYPE_CHECKING
 
 import numpy as np
+import shapely
 from gymnasium import spaces
 
 from . import fused
@@ -108,10 +109,12 @@ class RobotVectorObs:
         sensor_fov: bool = False,
         self_features: bool = False,
         aim_features: bool = False,
+        view_hint: bool = False,
     ) -> None:
         self.n = n_beams
         n = n_beams
         self.aim_features = aim_features
+        self.view_hint = view_hint
         self.map_ranges = map_ranges
         self.map_evidence = map_evidence
         self.sensor_fov = sensor_fov
@@ -121,6 +124,8 @@ class RobotVectorObs:
         low = np.concatenate([-np.ones(8), np.zeros(n), -np.ones(2 * n), np.zeros(m)])
         if aim_features:
             low = np.concatenate([low, np.tile([-1.0, -1.0, 0.0], 3), [0.0]])
+        if view_hint:
+            low = np.concatenate([low, [-1.0, -1.0, 0.0]])
         self.space = spaces.Box(
             low.astype(np.float32), np.ones(len(low), dtype=np.float32), dtype=np.float32
         )
@@ -146,8 +151,8 @@ class RobotVectorObs:
 
     def tail(self, sim: BatchSim, sel, x, y, psi) -> np.ndarray:
         """The entries after :attr:`head` ``(k, D - head)`` float64: ``map_evidence``'s
-        flags, then ``sensor_fov``, then ``self_features``, then ``aim_features``.  A new
-        entry goes here (and in the space's bounds)."""
+        flags, then ``sensor_fov``, then ``self_features``, then ``aim_features``, then
+        ``view_hint``.  A new entry goes here (and in the space's bounds)."""
         parts = []
         if self.map_evidence:
             parts.append(map_evidence(sim, sel, x, y, psi).reshape(len(x), 2 * self.n))
@@ -159,6 +164,8 @@ class RobotVectorObs:
             parts.append(np.column_stack([fov, reach]))
         if self.aim_features:
             parts.append(aim_features(sim.hulls[sel], sim.reach[sel], x, y, psi))
+        if self.view_hint:
+            parts.append(view_hint(sim.worlds[sel], x, y, psi))
         return np.concatenate(parts, axis=1)
 
     def _numpy(self, sim: BatchSim, idx: np.ndarray) -> np.ndarray:
@@ -262,6 +269,42 @@ def aim_features(hulls: np.ndarray, reach: np.ndarray, x, y, psi) -> np.ndarray:
     out[:, 2:9:3] = w / (2.0 * math.pi)
     far = np.hypot(hulls[..., 0] - x[:, None, None], hulls[..., 1] - y[:, None, None])
     out[:, 9] = np.clip(far.max(axis=(1, 2)) / reach, 0.0, 1.0)
+    return out
+
+
+def view_hint(worlds: list[World], x, y, psi) -> np.ndarray:
+    """``(k, 3)`` float64: the ``view_hint`` of poses ``(x, y, psi)`` (world frame, radians)
+    in ``worlds`` (one per pose): the way to the nearest pixel that sees every corner of K_G
+    and K_H with a passing aim, along the shortest grid path in the robot's free space
+    (:meth:`World.hint_field`): the unit vector toward the path's waypoint a few pixels ahead,
+    in the robot's frame (zero on it, and where no such pixel is reachable), then the length
+    of the way there, straight to the waypoint and on along the path, / diameter clipped to
+    ``[0, 1]`` (0 at a target pixel's centre, 1 where none is reachable)."""
+    out = np.zeros((len(x), 3))
+    c, s = libm(math.cos, psi), libm(math.sin, psi)
+    groups: dict[int, list[int]] = {}
+    for r, w in enumerate(worlds):
+        groups.setdefault(id(w), []).append(r)
+    for rows in groups.values():
+        w = worlds[rows[0]]
+        ways, dist = w.hint_field()
+        i, j = w.to_cell(dist.shape[0], x[rows], y[rows])
+        xy = np.column_stack([x[rows], y[rows]])
+        way = ways[-1, i, j]  # the nearest waypoint, unless a farther one is in plain sight
+        for far in ways[-2::-1]:
+            cand = far[i, j]
+            free = shapely.covers(w.robot_space, shapely.linestrings(np.stack([xy, cand], 1)))
+            way = np.where(free[:, None], cand, way)
+        dx, dy = way[:, 0] - x[rows], way[:, 1] - y[rows]
+        n = np.hypot(dx, dy)
+        wi, wj = w.to_cell(dist.shape[0], way[:, 0], way[:, 1])
+        left = dist[wi, wj] + n  # to the waypoint, then on along the path
+        far = np.isfinite(left) & (n > 1e-9 * w.diameter)
+        n = np.where(far, n, 1.0)
+        dx, dy = np.where(far, dx / n, 0.0), np.where(far, dy / n, 0.0)
+        out[rows, 0] = c[rows] * dx + s[rows] * dy
+        out[rows, 1] = c[rows] * dy - s[rows] * dx
+        out[rows, 2] = np.minimum(left / w.diameter, 1.0)
     return out
 
 
@@ -393,11 +436,13 @@ def make_observation(
     grid_views: bool = False,
     hull_views: bool = False,
     aim_views: int = 0,
+    view_hint: bool = False,
 ):
     """The observation builder for env ``kind`` ("robot" or "placement") and ``obs_type``;
     ``map_ranges`` / ``map_evidence`` / ``sensor_fov`` / ``self_features``: robot vector
     observations carry the map-predicted ranges / the per-beam evidence flags / the field of
-    view / the field of view and the reach too / the arcs of K_G and K_H (:func:`aim_features`);
+    view / the field of view and the reach too / the arcs of K_G and K_H (:func:`aim_features`)
+    / the way to the poses that see both hulls (:func:`view_hint`);
     Placement's grid: ``grid_views`` / ``hull_views`` / ``aim_views`` (a number of aims) /
     ``self_features`` add channels (:class:`PlacementGridObs`)."""
     if obs_type not in OBS_TYPES:
@@ -422,7 +467,7 @@ def make_observation(
         raise ValueError(f"{name}=True needs obs_type='grid' in Placement")
     if kind == "placement" and self_features:
         return PlacementVectorObs(n_beams, grid_size, self_features=True)
-    if map_ranges or map_evidence or sensor_fov or self_features or aim_features:
+    if map_ranges or map_evidence or sensor_fov or self_features or aim_features or view_hint:
         return RobotVectorObs(
             n_beams,
             grid_size,
@@ -431,5 +476,6 @@ def make_observation(
             sensor_fov=sensor_fov,
             self_features=self_features,
             aim_features=aim_features,
+            view_hint=view_hint,
         )
     return table[(kind, obs_type)](n_beams, grid_size)

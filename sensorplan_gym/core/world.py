@@ -80,6 +80,10 @@ MODELS = ("complete", "partial")
 MOTIONS = ("stationary", "translating", "rotating")
 #: cells along the longer side of the clearance field
 FIELD_SIZE = 64
+#: pixels along the side of the ``view_hint`` field's square (:meth:`World.hint_field`)
+HINT_SIZE = 128
+#: grid steps from a pixel to its ``view_hint`` waypoints, farthest first (:meth:`World.hint_field`)
+HINT_AHEAD = (6, 3, 1)
 
 
 @dataclass(frozen=True)
@@ -450,6 +454,94 @@ class World:
             )
             self._cache[key] = np.where(ok.reshape(aims, size, size), 255, 0).astype(np.uint8)
         return self._cache[key]
+
+    def hint_field(self, size: int = HINT_SIZE) -> tuple[np.ndarray, np.ndarray]:
+        """The ``view_hint`` field on :meth:`raster`'s grid of ``size`` pixels: ``(ahead,
+        dist)``.  ``dist`` ``(size, size)``: the length (scene units) of the cheapest
+        8-connected grid path from a pixel to the nearest *target pixel*, ``inf`` where none
+        can be reached; a step costs its length times ``1 + 4 (1 - c / 3)`` within 3 pixels
+        of the robot space's edge (``c`` the clearance in pixels), so paths keep off walls.
+        ``ahead`` ``(len(HINT_AHEAD), size, size, 2)``: waypoints on that path (world frame),
+        the pixels :data:`HINT_AHEAD` steps of steepest descent further on (the target pixel
+        itself near the end; the pixel's own centre where none can be reached).
+
+        Target pixels: centres in the robot's free space that see every corner of K_G and of
+        K_H (:meth:`hull_view_raster`), admit an aim that passes the aim test
+        (:meth:`aim_raster`, 16 aims) and lie outside K_G and K_H: map geometry alone, not the
+        recognizable region.  Paths run over pixels whose centres are in the robot's free
+        space; a pixel outside it takes the values of the nearest one inside."""
+        key = f"hint{size}"
+        got = self._cache.get(key)
+        if got is not None:
+            return got
+        from scipy import ndimage
+        from scipy.sparse import coo_matrix
+        from scipy.sparse.csgraph import dijkstra
+
+        scale, ox, oy = self.grid_transform(size)
+        ij = np.arange(size) + 0.5
+        X, Y = np.meshgrid(ox + ij / scale, oy + (size - ij) / scale)
+        space = shapely.contains_xy(self.robot_space, X, Y)
+        hv = self.hull_view_raster(size)
+        goal = space & (hv[0] > 0) & (hv[1] > 0) & (self.aim_raster(size, 16) > 0).any(axis=0)
+        for k in self.must_see:  # where the target may stand: never a sensor pose
+            goal &= ~shapely.contains_xy(shapely.Polygon(k), X, Y)
+        dist = np.full(size * size, np.inf)
+        nxt = np.arange(size * size)  # steepest-descent successor (flat pixel index)
+        if goal.any():
+            flat = np.arange(size * size).reshape(size, size)
+            free = np.flatnonzero(space)
+            cost = 1.0 + 4.0 * np.clip(1.0 - ndimage.distance_transform_edt(space) / 3.0, 0, 1)
+            rows, cols, w = [], [], []
+            for di, dj in ((0, 1), (1, 0), (1, 1), (1, -1)):
+                a = flat[: size - di, max(0, -dj) : size - max(0, dj)]
+                b = flat[di:, max(0, dj) : size + min(0, dj)]
+                ok = (
+                    space[: size - di, max(0, -dj) : size - max(0, dj)]
+                    & space[di:, max(0, dj) : size + min(0, dj)]
+                )
+                rows.append(a[ok])
+                cols.append(b[ok])
+                ca = cost[: size - di, max(0, -dj) : size - max(0, dj)][ok]
+                cb = cost[di:, max(0, dj) : size + min(0, dj)][ok]
+                w.append(0.5 * (ca + cb) * math.hypot(di, dj) / scale)
+            pos = np.full(size * size, -1)
+            pos[free] = np.arange(len(free))
+            g = coo_matrix(
+                (np.concatenate(w), (pos[np.concatenate(rows)], pos[np.concatenate(cols)])),
+                shape=(len(free), len(free)),
+            ).tocsr()
+            dist[free] = dijkstra(g, directed=False, indices=pos[flat[goal]], min_only=True)
+            d2 = dist.reshape(size, size)
+            pad = np.pad(d2, 1, constant_values=np.inf)
+            best = d2.copy()
+            succ = flat.copy()
+            for di in (-1, 0, 1):
+                for dj in (-1, 0, 1):
+                    if di == dj == 0:
+                        continue
+                    nb = pad[1 + di : 1 + di + size, 1 + dj : 1 + dj + size]
+                    better = nb < best
+                    best = np.where(better, nb, best)
+                    succ = np.where(better, np.roll(np.roll(flat, -di, 0), -dj, 1), succ)
+            nxt = succ.ravel()
+        ways = []
+        for k in HINT_AHEAD:
+            ahead = np.arange(size * size)
+            for _ in range(k):
+                ahead = nxt[ahead]
+            ways.append(np.stack([X.ravel()[ahead], Y.ravel()[ahead]], axis=1))
+        way = np.stack(ways).reshape(len(HINT_AHEAD), size, size, 2)
+        dist = dist.reshape(size, size)
+        inside = np.isfinite(dist)
+        if inside.any() and not inside.all():  # outside the robot's space: the nearest
+            near = ndimage.distance_transform_edt(
+                ~inside, return_distances=False, return_indices=True
+            )
+            dist = dist[near[0], near[1]]
+            way = way[:, near[0], near[1]]
+        got = self._cache[key] = (way, dist)
+        return got
 
     def _seen_from_all(self, size: int, groups: list[np.ndarray]) -> np.ndarray:
         """``(len(groups), size, size)`` uint8: 255 where a pixel's centre lies in the

@@ -79,6 +79,10 @@ aim_views : bool, default False -- Placement's grid observation gets ``placement
     channels, one per aim of the Placement actions: where that aim from the pixel's centre keeps
     K_G and K_H in the field of view (with the aim and position margins) and within range, the
     angular half of the reward's test (occlusion is the other).
+view_hint : bool, default False -- Navigate/Recognize vector observations end with the way
+    to the nearest pose that sees every corner of K_G and K_H with a passing aim (map geometry,
+    not the recognizable region): the first step of the shortest grid path there in the robot's
+    frame and its length / diameter (:func:`sensorplan_gym.core.observations.view_hint`).
 aim_features : bool, default False -- Navigate/Recognize vector observations end with the
     arcs of directions that K_G and K_H (the swept hulls) cover from the robot's pose, relative
     to its heading, and their farthest vertex's distance over the reach (see
@@ -345,6 +349,7 @@ class SensorPlanBatch(BatchSim):
         grid_views: bool = False,
         hull_views: bool = False,
         aim_views: bool = False,
+        view_hint: bool = False,
         **action_kw: Any,
     ) -> None:
         for name, v in (
@@ -386,6 +391,7 @@ class SensorPlanBatch(BatchSim):
             ("grid_views", grid_views),
             ("hull_views", hull_views),
             ("aim_views", aim_views),
+            ("view_hint", view_hint),
         ):
             if not isinstance(v, bool):
                 raise ValueError(f"{name} must be True or False, got {v!r}")
@@ -427,6 +433,7 @@ class SensorPlanBatch(BatchSim):
             grid_views=grid_views,
             hull_views=hull_views,
             aim_views=int(action_kw.get("placement_aims", 8)) if aim_views else 0,
+            view_hint=view_hint,
         )
         self.single_observation_space = self.obs.space
         self.actions = make_actions(

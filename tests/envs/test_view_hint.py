@@ -1,0 +1,84 @@
+"""``view_hint``: the way to the poses that see every corner of K_G and K_H with a passing aim
+(map geometry, :meth:`World.hint_field`), at the end of Navigate/Recognize vector observations."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+import pytest
+import shapely
+from gymnasium.utils.env_checker import check_env
+
+import sensorplan_gym  # noqa: F401
+from sensorplan_gym.core.world import HINT_SIZE
+
+KW = {"self_features": True, "aim_features": True}
+
+
+def _world(scene: str):
+    env = gym.make("sensorplan/Navigate-v0", scene=scene, view_hint=True, **KW)
+    env.reset(seed=0)
+    return env, env.unwrapped.world
+
+
+def test_space_and_check_env():
+    plain = gym.make("sensorplan/Recognize-v0", scene="lab", **KW)
+    env = gym.make("sensorplan/Recognize-v0", scene="lab", view_hint=True, **KW)
+    check_env(env.unwrapped, skip_render_check=True)
+    a, _ = plain.reset(seed=3)
+    b, _ = env.reset(seed=3)
+    assert b.shape[0] == a.shape[0] + 3 and np.array_equal(b[:-3], a)
+    assert np.array_equal(env.observation_space.low[-3:], [-1, -1, 0])
+    hx, hy, d = b[-3:]
+    assert abs(np.hypot(hx, hy) - 1) < 1e-6 and 0 < d < 1
+
+
+def test_field_targets_and_descent():
+    """Distance 0 exactly on the target pixels (free, every hull corner seen, some aim
+    passes, outside both hulls); elsewhere finite distances fall along the field's
+    waypoints; the target pixels lie in the recognizable region (all but a sliver)."""
+    _, w = _world("lab")
+    ways, dist = w.hint_field()
+    s = HINT_SIZE
+    scale, ox, oy = w.grid_transform(s)
+    ij = np.arange(s) + 0.5
+    X, Y = np.meshgrid(ox + ij / scale, oy + (s - ij) / scale)
+    space = shapely.contains_xy(w.robot_space, X, Y)
+    hv = w.hull_view_raster(s)
+    goal = space & (hv[0] > 0) & (hv[1] > 0) & (w.aim_raster(s, 16) > 0).any(axis=0)
+    for k in w.must_see:
+        goal &= ~shapely.contains_xy(shapely.Polygon(k), X, Y)
+    assert goal.sum() > 100
+    assert np.array_equal(dist[space] == 0, goal[space])
+    assert shapely.contains_xy(w.region, X[goal], Y[goal]).mean() > 0.99
+    fin = space & np.isfinite(dist) & ~goal
+    i, j = w.to_cell(s, ways[-1, ..., 0][fin], ways[-1, ..., 1][fin])
+    assert (dist[i, j] < dist[fin]).all()  # one step of descent gets closer
+
+
+@pytest.mark.parametrize("scene", ["lab", "warehouse"])
+def test_following_the_hint_recognizes(scene):
+    """A fixed controller -- move along the hint, slow down near its end, turn toward the
+    joint arc of K_G and K_H (``aim_features``) -- reaches a recognizing pose from random
+    starts: the hint leads where the exact reward says the pose tells G from H."""
+    env = gym.make("sensorplan/Navigate-v0", scene=scene, random_start=True, view_hint=True, **KW)
+    wins = 0
+    for e in range(5):
+        o, info = env.reset(seed=100 + e)
+        for _ in range(200):
+            hx, hy, d = o[-3:]
+            jc, js = o[-13], o[-12]
+            speed = min(1.0, d / 0.03)
+            turn = np.clip(np.arctan2(js, jc) / 0.5, -1, 1)
+            o, _, term, trunc, info = env.step(np.array([hx * speed, hy * speed, turn], "f4"))
+            if term or trunc:
+                break
+        wins += bool(info["is_success"])
+    assert wins == 5
+
+
+def test_view_hint_needs_a_robot_vector_observation():
+    with pytest.raises(ValueError, match="view_hint=True needs obs_type='vector'"):
+        gym.make("sensorplan/Placement-v0", scene="edr", view_hint=True)
+    with pytest.raises(ValueError, match="view_hint"):
+        gym.make("sensorplan/Navigate-v0", scene="edr", obs_type="grid", view_hint=True)
