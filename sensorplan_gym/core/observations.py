@@ -61,6 +61,7 @@ from . import fused
 from .kernels import libm
 from .queries import hull_arcs, joint_arc
 from .sensor import RangeSensor
+from .world import HINT_AHEAD
 
 if TYPE_CHECKING:  # pragma: no cover
     from .sim import BatchSim
@@ -280,31 +281,43 @@ def view_hint(worlds: list[World], x, y, psi) -> np.ndarray:
     in the robot's frame (zero on it, and where no such pixel is reachable), then the length
     of the way there, straight to the waypoint and on along the path, / diameter clipped to
     ``[0, 1]`` (0 at a target pixel's centre, 1 where none is reachable)."""
-    out = np.zeros((len(x), 3))
-    c, s = libm(math.cos, psi), libm(math.sin, psi)
+    k = len(x)
     groups: dict[int, list[int]] = {}
     for r, w in enumerate(worlds):
         groups.setdefault(id(w), []).append(r)
+    levels = len(HINT_AHEAD)
+    ways = np.empty((levels, k, 2))
+    rest = np.empty(k)  # the path's length on from each waypoint (no waypoint: inf)
+    space = np.empty(k, dtype=object)
+    size = np.empty(k)
     for rows in groups.values():
         w = worlds[rows[0]]
-        ways, dist = w.hint_field()
+        field, dist = w.hint_field()
         i, j = w.to_cell(dist.shape[0], x[rows], y[rows])
-        xy = np.column_stack([x[rows], y[rows]])
-        way = ways[-1, i, j]  # the nearest waypoint, unless a farther one is in plain sight
-        for far in ways[-2::-1]:
-            cand = far[i, j]
-            free = shapely.covers(w.robot_space, shapely.linestrings(np.stack([xy, cand], 1)))
-            way = np.where(free[:, None], cand, way)
-        dx, dy = way[:, 0] - x[rows], way[:, 1] - y[rows]
-        n = np.hypot(dx, dy)
-        wi, wj = w.to_cell(dist.shape[0], way[:, 0], way[:, 1])
-        left = dist[wi, wj] + n  # to the waypoint, then on along the path
-        far = np.isfinite(left) & (n > 1e-9 * w.diameter)
-        n = np.where(far, n, 1.0)
-        dx, dy = np.where(far, dx / n, 0.0), np.where(far, dy / n, 0.0)
-        out[rows, 0] = c[rows] * dx + s[rows] * dy
-        out[rows, 1] = c[rows] * dy - s[rows] * dx
-        out[rows, 2] = np.minimum(left / w.diameter, 1.0)
+        ways[:, rows] = field[:, i, j]
+        space[rows] = w.robot_space
+        size[rows] = w.diameter
+    xy = np.column_stack([x, y])
+    way = ways[-1]  # the nearest waypoint, unless a farther one is in plain sight
+    for far in ways[-2::-1]:
+        free = shapely.covers(space, shapely.linestrings(np.stack([xy, far], axis=1)))
+        way = np.where(free[:, None], far, way)
+    for rows in groups.values():
+        w = worlds[rows[0]]
+        dist = w.hint_field()[1]
+        wi, wj = w.to_cell(dist.shape[0], way[rows, 0], way[rows, 1])
+        rest[rows] = dist[wi, wj]
+    dx, dy = way[:, 0] - x, way[:, 1] - y
+    n = np.hypot(dx, dy)
+    left = rest + n  # to the waypoint, then on along the path
+    far = np.isfinite(left) & (n > 1e-9 * size)
+    n = np.where(far, n, 1.0)
+    dx, dy = np.where(far, dx / n, 0.0), np.where(far, dy / n, 0.0)
+    c, s = libm(math.cos, psi), libm(math.sin, psi)
+    out = np.empty((k, 3))
+    out[:, 0] = c * dx + s * dy
+    out[:, 1] = c * dy - s * dx
+    out[:, 2] = np.minimum(left / size, 1.0)
     return out
 
 
