@@ -418,13 +418,20 @@ class World:
     def hull_view_raster(self, size: int) -> np.ndarray:
         """``(2, size, size)`` uint8 on :meth:`raster`'s grid: 255 where a pixel's centre lies
         in the visibility polygon of *every* vertex of K_G (channel 0) / K_H (channel 1), the
-        hulls the sensor must see, else 0: where all of a hull's corners are in view.  Each
-        vertex is moved 1e-9 of the way towards its hull's centre first; one still outside the
-        free space (a corner on a wall) is left out; a hull with none left gives 0."""
+        hulls the sensor must see, and outside both hulls (where the target may stand), else 0:
+        where all of a hull's corners are in view from outside.  Each vertex is moved 1e-9 of
+        the way towards its hull's centre first; one still outside the free space (a corner on
+        a wall) is left out; a hull with none left gives 0."""
         key = f"hullviews{size}"
         if key not in self._cache:
             corners = [h + 1e-9 * (h.mean(axis=0) - h) for h in self.must_see]
-            self._cache[key] = self._seen_from_all(size, corners)
+            out = self._seen_from_all(size, corners)
+            scale, ox, oy = self.grid_transform(size)
+            ij = np.arange(size) + 0.5
+            X, Y = np.meshgrid(ox + ij / scale, oy + (size - ij) / scale)
+            for h in self.must_see:
+                out[:, shapely.contains_xy(shapely.Polygon(h), X, Y)] = 0
+            self._cache[key] = out
         return self._cache[key]
 
     def aim_raster(self, size: int, aims: int) -> np.ndarray:
@@ -484,8 +491,6 @@ class World:
         space = shapely.contains_xy(self.robot_space, X, Y)
         hv = self.hull_view_raster(size)
         goal = space & (hv[0] > 0) & (hv[1] > 0) & (self.aim_raster(size, 16) > 0).any(axis=0)
-        for k in self.must_see:  # where the target may stand: never a sensor pose
-            goal &= ~shapely.contains_xy(shapely.Polygon(k), X, Y)
         dist = np.full(size * size, np.inf)
         nxt = np.arange(size * size)  # steepest-descent successor (flat pixel index)
         if goal.any():

@@ -53,6 +53,8 @@ def test_pixels_see_every_corner_against_cgal():
         want = np.ones((size, size), dtype=bool)
         for vis in views:
             want &= shapely.contains_xy(vis, X, Y)
+        for h in world.must_see:  # outside both hulls only
+            want &= ~shapely.contains_xy(shapely.Polygon(h), X, Y)
         near = np.zeros_like(want)  # pixel centres on a view's edge: rounding decides
         for vis in views:
             d = shapely.distance(vis.boundary, shapely.points(X, Y))
