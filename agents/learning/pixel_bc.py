@@ -393,6 +393,13 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--epochs", type=int, default=40)
     p.add_argument("--width", type=int, default=48)
     p.add_argument("--seed", type=int, default=0)
+    p.add_argument(
+        "--seeds",
+        type=int,
+        nargs="+",
+        default=None,
+        help="fit once per seed on the one labelled pool (outputs OUT/seed_<s>/)",
+    )
     p.add_argument("--jobs", type=int, default=None, help="processes that build the pool")
     p.add_argument("--threads", type=int, default=None, help="torch threads")
     p.add_argument(
@@ -423,22 +430,27 @@ def main(argv: list[str] | None = None) -> int:
     device = a.device
     if device == "auto":
         device = "cuda" if torch.cuda.is_available() else "cpu"
-    net = fit(obs, masks, epochs=a.epochs, seed=a.seed, width=a.width, device=device, aim=aim)
-    t2 = time.perf_counter()
-    config = {
-        "env_id": ENV_ID,
-        "env_kwargs": {**pool, **ENV_KWARGS},
-        "seed": a.seed,
-        "epochs": a.epochs,
-        "command": "python -m agents.learning.pixel_bc "
-        + " ".join(sys.argv[1:] if argv is None else argv),
-        "labelled_scenes": len(obs),
-        "solvable_fraction": solvable,
-        "wall_time_s": {"label": round(t1 - t0, 1), "fit": round(t2 - t1, 1)},
-        "fit_device": device,
-    }
-    path = PixelPolicy(net, aim=aim).save(Path(a.out) / "final_model.pt", config)
-    print(json.dumps({"model": str(path), **config["wall_time_s"]}))
+    seeds = a.seeds if a.seeds else [a.seed]
+    label_s = round(t1 - t0, 1)
+    for seed in seeds:
+        t1 = time.perf_counter()
+        net = fit(obs, masks, epochs=a.epochs, seed=seed, width=a.width, device=device, aim=aim)
+        t2 = time.perf_counter()
+        config = {
+            "env_id": ENV_ID,
+            "env_kwargs": {**pool, **ENV_KWARGS},
+            "seed": seed,
+            "epochs": a.epochs,
+            "command": "python -m agents.learning.pixel_bc "
+            + " ".join(sys.argv[1:] if argv is None else argv),
+            "labelled_scenes": len(obs),
+            "solvable_fraction": solvable,
+            "wall_time_s": {"label": label_s, "fit": round(t2 - t1, 1)},
+            "fit_device": device,
+        }
+        out = Path(a.out) / f"seed_{seed}" if a.seeds else Path(a.out)
+        path = PixelPolicy(net, aim=aim).save(out / "final_model.pt", config)
+        print(json.dumps({"model": str(path), **config["wall_time_s"]}), flush=True)
     return 0
 
 

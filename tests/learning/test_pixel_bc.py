@@ -190,3 +190,18 @@ def test_channel_rule_plays_right_actions_from_the_channels():
     blank = obs.copy()
     blank[:, aim[0] : aim[1]] = 0
     assert pixel_bc.channel_rule(blank, aim).tolist() == [0]
+
+
+def test_cli_fits_several_seeds_on_one_pool(tmp_path):
+    """``--seeds`` labels the pool once and fits once per seed, into ``seed_<s>/``."""
+    import yaml
+
+    pixel_bc.main(
+        ["--difficulty", "easy", "--pool-size", "2", "--epochs", "1", "--width", "8",
+         "--seeds", "3", "4", "--out", str(tmp_path)]
+    )  # fmt: skip
+    cfgs = [
+        yaml.safe_load((tmp_path / f"seed_{s}" / "final_model.yaml").read_text()) for s in (3, 4)
+    ]
+    assert [c["seed"] for c in cfgs] == [3, 4]
+    assert cfgs[0]["wall_time_s"]["label"] == cfgs[1]["wall_time_s"]["label"]
