@@ -32,7 +32,10 @@ from .checks import EXTRA_OF_MODULE, check_writable_file, missing_extra_message
 __all__ = ["EXTRA_OF_MODULE", "build_parser", "main"]
 
 ENV_CHOICES_HELP = "sensorplan/Placement-v0, sensorplan/Navigate-v0 or sensorplan/Recognize-v0"
-POLICIES_HELP = "'oracle', 'random' and/or paths to model zips or pixel policies (.pt)"
+POLICIES_HELP = (
+    "'oracle', 'random', 'hint-rule' (Navigate-v0: a fixed controller on the view_hint and "
+    "aim_features observations) and/or paths to model zips or pixel policies (.pt)"
+)
 
 
 def _json_dict(text: str) -> dict:

@@ -46,6 +46,7 @@ import numpy as np
 
 from ..checks import check_writable_dir
 from ..learning.policies import (
+    RULES,
     check_policies,
     load_policy,
     make_env,
@@ -274,7 +275,10 @@ def evaluate(
         env = make_env(env_id, play_kwargs)
         try:
             policy = load_policy(spec, env, seed=seed)
-            meta: dict[str, Any] = {"kind": spec if spec in ("oracle", "random") else "model"}
+            kind = spec if spec in ("oracle", "random") else "rule" if spec in RULES else "model"
+            meta: dict[str, Any] = {"kind": kind}
+            if kind == "rule":
+                meta["play_env_kwargs"] = play_kwargs
             if meta["kind"] == "model":
                 cfg = model_config(spec) or {}
                 meta.update(

@@ -32,6 +32,7 @@ __all__ = [
     "ALGOS",
     "CONTRIB_ALGOS",
     "ModelPolicy",
+    "RULES",
     "RandomPolicy",
     "check_policies",
     "load_policy",
@@ -200,8 +201,18 @@ class RandomPolicy:
         return np.stack([np.asarray(self.action_space.sample()) for _ in range(n)]), state
 
 
+#: policy specs that name a fixed controller, with the config it is played with (its
+#: observation kwargs): ``"hint-rule"`` (:mod:`agents.planning.hint_rule`)
+RULES = {
+    "hint-rule": {"algo": "hint_rule", "env_kwargs": {"view_hint": True, "aim_features": True}}
+}
+
+
 def model_config(path: str | Path) -> dict | None:
-    """The resolved training config saved beside a model zip (``None`` if there is none)."""
+    """The resolved training config saved beside a model zip (``None`` if there is none); for a
+    rule of :data:`RULES`, its config."""
+    if str(path) in RULES:
+        return RULES[str(path)]
     import yaml
 
     p = Path(path)
@@ -294,7 +305,7 @@ def check_policies(specs: list[str]) -> None:
 
     missing, bad = [], []
     for spec in specs:
-        if spec in ("oracle", "random"):
+        if spec in ("oracle", "random", *RULES):
             continue
         try:
             path = model_path(spec)
@@ -330,8 +341,8 @@ def check_policies(specs: list[str]) -> None:
 
 
 def load_policy(spec: str, env, *, seed: int = 0, device: str = "cpu"):
-    """A policy object for ``spec`` (``"oracle"``, ``"random"``, a model zip or a pixel
-    policy's ``.pt``), bound to
+    """A policy object for ``spec`` (``"oracle"``, ``"random"``, a rule of :data:`RULES`, a
+    model zip or a pixel policy's ``.pt``), bound to
     ``env`` where that matters.  Raises ``FileNotFoundError`` for a missing zip and
     ``ValueError`` for a zip no algorithm can load."""
     if spec == "oracle":
@@ -340,6 +351,10 @@ def load_policy(spec: str, env, *, seed: int = 0, device: str = "cpu"):
         return OraclePolicy(env)
     if spec == "random":
         return RandomPolicy(env.action_space, seed=seed, observation_space=env.observation_space)
+    if spec == "hint-rule":
+        from ..planning.hint_rule import HintRulePolicy
+
+        return HintRulePolicy(env)
     path = model_path(spec)
     cfg = model_config(path) or {}
     if path.suffix == ".pt":

@@ -80,3 +80,23 @@ def test_view_hint_needs_a_robot_vector_observation():
         gym.make("sensorplan/Placement-v0", scene="edr", view_hint=True)
     with pytest.raises(ValueError, match="view_hint"):
         gym.make("sensorplan/Navigate-v0", scene="edr", obs_type="grid", view_hint=True)
+
+
+def test_hint_rule_is_a_policy_spec():
+    """``"hint-rule"`` is played by ``evaluate`` with its observation kwargs merged under the
+    user's; it refuses an env without them."""
+    pytest.importorskip("yaml")
+    from agents.evaluation.evaluate import evaluate
+    from agents.planning.hint_rule import HintRulePolicy
+
+    res = evaluate(
+        "sensorplan/Navigate-v0", ["hint-rule", "oracle"], episodes=4,
+        env_kwargs={"scene": "lab", "random_start": True}, out=False, plot=False, verbose=False,
+    )  # fmt: skip
+    rule = res["policies"][0]
+    assert rule["kind"] == "rule" and rule["success_rate"] == 1.0
+    with pytest.raises(ValueError, match="view_hint=True and aim_features=True"):
+        HintRulePolicy(gym.make("sensorplan/Navigate-v0", scene="lab", view_hint=True))
+    with pytest.raises(ValueError, match="Navigate-v0"):
+        HintRulePolicy(gym.make("sensorplan/Recognize-v0", scene="lab", view_hint=True,
+                                aim_features=True))  # fmt: skip
