@@ -17,7 +17,6 @@ from __future__ import annotations
 from typing import Any
 
 from . import fuzz_swept
-from .fuzz_contacts import summary
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -26,13 +25,10 @@ def main(argv: list[str] | None = None) -> None:
 
 def render(data: dict[str, Any]) -> str:
     """The page fragment: scenes fuzzed with the certified bounds and violations per kind."""
-    a, b = data["seeds"]
-    return summary(
+    return fuzz_swept.render(
         data,
-        f"Seeds {a}-{b}: {data['valid']} valid scenes of {data['scenes']}, every query type "
         "and the certified bounds of the swept partial region and of the 5.2 / mixed "
-        f"recognizable region, each scene in four frames; {data['seconds'] / 3600.0:.1f} "
-        f"process-hours in chunks of {data['chunk']} seeds.",
+        "recognizable region",
     )
 
 

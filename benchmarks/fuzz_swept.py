@@ -114,15 +114,17 @@ def main(argv: list[str] | None = None, *, name: str = "fuzz_swept", doc: str = 
     _results.write(name, data, args.out, args.update_results)
 
 
-def render(data: dict[str, Any]) -> str:
-    """The page fragment: scenes fuzzed and violations per kind."""
+def render(
+    data: dict[str, Any],
+    what: str = "including the swept partial region and the 5.2 recognizable region",
+) -> str:
+    """The page fragment: scenes fuzzed (every query type, ``what``) and violations per kind."""
     a, b = data["seeds"]
     return summary(
         data,
         f"Seeds {a}-{b}: {data['valid']} valid scenes of {data['scenes']}, every query type "
-        "including the swept partial region and the 5.2 recognizable region, each scene in "
-        f"four frames; {data['seconds'] / 3600.0:.1f} process-hours in chunks of "
-        f"{data['chunk']} seeds.",
+        f"{what}, each scene in four frames; {data['seconds'] / 3600.0:.1f} process-hours in "
+        f"chunks of {data['chunk']} seeds.",
     )
 
 

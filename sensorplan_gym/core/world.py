@@ -316,19 +316,21 @@ class World:
         """Whether aim ``psi`` from ``(x, y)`` keeps K_G and K_H (the swept hulls) inside the
         field of view for every aim in ``psi +- eps_aim`` and every placement within
         ``eps_pos``, and within ``max_range`` (:func:`.queries.aim_ok_batch` for one pose)."""
+        return bool(self.aim_ok_many(np.array([x]), np.array([y]), np.array([psi]))[0])
+
+    def aim_ok_many(self, x: np.ndarray, y: np.ndarray, psi: np.ndarray) -> np.ndarray:
+        """:meth:`aim_ok` of many poses ``(N,)`` (world frame, radians): ``(N,)`` bool."""
         r = self.batch_rows()
-        return bool(
-            aim_ok_batch(
-                np.array([x], dtype=np.float64),
-                np.array([y], dtype=np.float64),
-                np.array([psi], dtype=np.float64),
-                r["hulls"][None],
-                r["centers"][None],
-                fov=self.fov,
-                eps_aim=self.eps_aim,
-                eps_pos=self.eps_pos,
-                max_range=self.max_range,
-            )[0]
+        return aim_ok_batch(
+            np.asarray(x, dtype=np.float64),
+            np.asarray(y, dtype=np.float64),
+            np.asarray(psi, dtype=np.float64),
+            r["hulls"][None],
+            r["centers"][None],
+            fov=self.fov,
+            eps_aim=self.eps_aim,
+            eps_pos=self.eps_pos,
+            max_range=self.max_range,
         )
 
     def query(self, x: float, y: float, psi: float) -> tuple[bool, float]:
@@ -385,9 +387,7 @@ class World:
         top (max y)."""
         key = f"raster{size}"
         if key not in self._cache:
-            scale, ox, oy = self.grid_transform(size)
-            ij = np.arange(size) + 0.5
-            X, Y = np.meshgrid(ox + ij / scale, oy + (size - ij) / scale)
+            X, Y = self.pixel_centres(size)
             out = np.zeros((3, size, size), dtype=np.uint8)
             out[0] = np.where(shapely.contains_xy(self.free_space, X, Y), 0, 255)
             for k, g in ((1, self.goal_geom), (2, self.failure_geom)):
@@ -426,9 +426,7 @@ class World:
         if key not in self._cache:
             corners = [h + 1e-9 * (h.mean(axis=0) - h) for h in self.must_see]
             out = self._seen_from_all(size, corners)
-            scale, ox, oy = self.grid_transform(size)
-            ij = np.arange(size) + 0.5
-            X, Y = np.meshgrid(ox + ij / scale, oy + (size - ij) / scale)
+            X, Y = self.pixel_centres(size)
             for h in self.must_see:
                 out[:, shapely.contains_xy(shapely.Polygon(h), X, Y)] = 0
             self._cache[key] = out
@@ -442,22 +440,10 @@ class World:
         ``max_range``), else 0.  Occlusion is not part of it (:meth:`hull_view_raster`)."""
         key = f"aims{size}_{aims}"
         if key not in self._cache:
-            scale, ox, oy = self.grid_transform(size)
-            ij = np.arange(size) + 0.5
-            X, Y = np.meshgrid(ox + ij / scale, oy + (size - ij) / scale)
+            X, Y = self.pixel_centres(size)
             psi = math.pi * (-1.0 + 2.0 * np.arange(aims) / aims)
-            n = size * size
-            r = self.batch_rows()
-            ok = aim_ok_batch(
-                np.tile(X.ravel(), aims),
-                np.tile(Y.ravel(), aims),
-                np.repeat(psi, n),
-                r["hulls"][None],
-                r["centers"][None],
-                fov=self.fov,
-                eps_aim=self.eps_aim,
-                eps_pos=self.eps_pos,
-                max_range=self.max_range,
+            ok = self.aim_ok_many(
+                np.tile(X.ravel(), aims), np.tile(Y.ravel(), aims), np.repeat(psi, size * size)
             )
             self._cache[key] = np.where(ok.reshape(aims, size, size), 255, 0).astype(np.uint8)
         return self._cache[key]
@@ -485,9 +471,7 @@ class World:
         from scipy.sparse import coo_matrix
         from scipy.sparse.csgraph import dijkstra
 
-        scale, ox, oy = self.grid_transform(size)
-        ij = np.arange(size) + 0.5
-        X, Y = np.meshgrid(ox + ij / scale, oy + (size - ij) / scale)
+        X, Y = self.pixel_centres(size)
         space = shapely.contains_xy(self.robot_space, X, Y)
         hv = self.hull_view_raster(size)
         goal = space & (hv[0] > 0) & (hv[1] > 0) & (self.aim_raster(size, 16) > 0).any(axis=0)
@@ -509,7 +493,7 @@ class World:
                 cols.append(b[ok])
                 ca = cost[: size - di, max(0, -dj) : size - max(0, dj)][ok]
                 cb = cost[di:, max(0, dj) : size + min(0, dj)][ok]
-                w.append(0.5 * (ca + cb) * math.hypot(di, dj) / scale)
+                w.append(0.5 * (ca + cb) * math.hypot(di, dj) / self.grid_transform(size)[0])
             pos = np.full(size * size, -1)
             pos[free] = np.arange(len(free))
             g = coo_matrix(
@@ -554,9 +538,7 @@ class World:
         are left out; a group with none left gives 0)."""
         from geometry._vis import domain_from_geometry, visibility_polygon
 
-        scale, ox, oy = self.grid_transform(size)
-        ij = np.arange(size) + 0.5
-        X, Y = np.meshgrid(ox + ij / scale, oy + (size - ij) / scale)
+        X, Y = self.pixel_centres(size)
         dom = domain_from_geometry(self.free_space)
         out = np.zeros((len(groups), size, size), dtype=np.uint8)
         for k, pts in enumerate(groups):
@@ -566,6 +548,13 @@ class World:
                 seen &= shapely.contains_xy(visibility_polygon(dom, v), X, Y)
             out[k] = np.where(seen, 255, 0)
         return out
+
+    def pixel_centres(self, size: int) -> tuple[np.ndarray, np.ndarray]:
+        """``(X, Y)`` ``(size, size)``: the world coordinates of the centres of :meth:`raster`'s
+        pixels (row 0 at the top)."""
+        scale, ox, oy = self.grid_transform(size)
+        ij = np.arange(size) + 0.5
+        return tuple(np.meshgrid(ox + ij / scale, oy + (size - ij) / scale))
 
     def grid_transform(self, size: int) -> tuple[float, float, float]:
         span = float(max(self.hi - self.lo))
