@@ -393,7 +393,13 @@ def load_policy(spec: str, env, *, seed: int = 0, device: str = "cpu"):
             vecnorm = pickle.load(f)
         vecnorm.training = False
     if frame_stack > 1 or vecnorm is not None:
-        return ModelPolicy(
+        model = ModelPolicy(
             model, env.observation_space, frame_stack=frame_stack, vecnormalize=vecnorm
+        )
+    if cfg.get("residual"):  # a correction of a fixed controller (agents.learning.residual)
+        from .residual import RESIDUAL_SCALE, ResidualPolicy
+
+        return ResidualPolicy(
+            model, cfg["residual"], float(cfg.get("residual_scale", RESIDUAL_SCALE))
         )
     return model

@@ -354,6 +354,10 @@ def train(
     if frame_stack < 1:
         raise ValueError(f"frame_stack must be a positive integer, got {frame_stack}")
     norm_kw = _normalize_kwargs(hp.pop("normalize", None), hp.get("gamma"))
+    residual = hp.pop("residual", None)
+    residual_scale = float(hp.pop("residual_scale", 0.5))
+    if residual is not None and norm_kw is not None:
+        raise ValueError("residual: the base controller reads raw observations; drop normalize")
     eval_kw = hp.pop("eval_env_kwargs", None) or {}
     if not isinstance(eval_kw, dict):
         raise ValueError(f"eval_env_kwargs must be a mapping of env kwargs, got {eval_kw!r}")
@@ -407,6 +411,11 @@ def train(
 
         venv = VecFrameStack(venv, frame_stack)
         eval_env = VecFrameStack(eval_env, frame_stack)
+    if residual is not None:  # the agent corrects a fixed controller (agents.learning.residual)
+        from .residual import ResidualVecEnv
+
+        venv = ResidualVecEnv(venv, str(residual), residual_scale)
+        eval_env = ResidualVecEnv(eval_env, str(residual), residual_scale)
 
     kwargs = dict(hp)
     pk = dict(kwargs.pop("policy_kwargs", None) or {})
@@ -435,6 +444,7 @@ def train(
         "env_kwargs": resolved_env_kwargs,
         "policy": policy,
         "frame_stack": frame_stack,
+        **({"residual": str(residual), "residual_scale": residual_scale} if residual else {}),
         "normalize": norm_kw is not None,
         "normalize_kwargs": norm_kw,
         "hyperparams": hyperparams,
