@@ -1,0 +1,136 @@
+"""Navigate-v0 on the ``hard`` level with the ``view_hint`` observation: learned policies, the
+fixed hint rule and the oracle.
+
+    python -m benchmarks.navigate_hint [--episodes 100] [--seed 0] [--models PATH ...]
+
+``sensorplan benchmark --env sensorplan/Navigate-v0 --level hard --splits test ood real``
+(:func:`agents.evaluation.benchmark.benchmark`) of the shipped Navigate policies trained with
+``view_hint`` (``agents/pretrained/ppo_navigate_hint.zip``: PPO; ``ppo_navigate_residual.zip``:
+PPO correcting the hint rule, :mod:`agents.learning.residual`), the previous shipped
+``ppo_navigate_hard``, the hint rule (:mod:`agents.planning.hint_rule`, no learning) and the
+oracle, every policy on the same episode seeds from random starts.  Besides success it reports
+the mean path length over the episodes that the policy and the oracle both solve, as a
+multiple of the oracle's (issue 22's target: at most 1.3).  Needs the ``rl`` extra.
+"""
+
+from __future__ import annotations
+
+import argparse
+import tempfile
+import time
+from pathlib import Path
+from typing import Any
+
+from . import _results
+
+ENV = "sensorplan/Navigate-v0"
+PRETRAINED = Path(__file__).resolve().parents[1] / "agents" / "pretrained"
+MODELS = [
+    PRETRAINED / "ppo_navigate_hint.zip",
+    PRETRAINED / "ppo_navigate_residual.zip",
+    PRETRAINED / "ppo_navigate_hard.zip",
+]
+
+
+def path_ratio(policy: dict[str, Any], oracle: dict[str, Any]) -> float | None:
+    """Mean path length of ``policy`` over the episodes it and ``oracle`` both solve, over the
+    oracle's mean on the same episodes (``None`` when they solve none in common); the results
+    are :func:`agents.evaluation.evaluate.evaluate`'s per-policy dictionaries."""
+    a, b = policy["per_episode"], oracle["per_episode"]
+    both = [i for i, (x, y) in enumerate(zip(a["success"], b["success"], strict=True)) if x and y]
+    if not both:
+        return None
+    num = sum(a["path_length"][i] for i in both)
+    den = sum(b["path_length"][i] for i in both)
+    return num / den if den > 0 else None
+
+
+def main(argv: list[str] | None = None) -> int:
+    from agents.evaluation.benchmark import benchmark
+    from agents.learning.policies import policy_label
+
+    ap = argparse.ArgumentParser(
+        prog="python -m benchmarks.navigate_hint", description=__doc__.split("\n\n")[0]
+    )
+    ap.add_argument("--episodes", type=int, default=100)
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--models", type=Path, nargs="+", default=MODELS, help="model zips")
+    _results.add_output_args(ap, "navigate_hint")
+    args = ap.parse_args(argv)
+    t0 = time.perf_counter()
+    specs = [str(m) for m in args.models] + ["hint-rule", "oracle"]
+    with tempfile.TemporaryDirectory() as tmp:
+        res = benchmark(
+            ENV,
+            specs,
+            episodes=args.episodes,
+            seed=args.seed,
+            split_names=["test", "ood", "real"],
+            level="hard",
+            out=tmp,
+            verbose=False,
+        )
+    rows = []
+    for split, r in res["splits"].items():
+        oracle = next(p for p in r["policies"] if p["spec"] == "oracle")
+        for p in r["policies"]:
+            rows.append(
+                {
+                    "split": split,
+                    "policy": policy_label(p["spec"]),
+                    "successes": p["successes"],
+                    "episodes": p["episodes"],
+                    "distinct": p["distinct_episodes"],
+                    "ci95": list(p["success_ci95"]),
+                    "path_ratio": None if p is oracle else path_ratio(p, oracle),
+                }
+            )
+    data: dict[str, Any] = {
+        "command": _results.command("benchmarks.navigate_hint", argv),
+        "machine": _results.machine(),
+        "policies": [policy_label(s) for s in specs],
+        "rows": rows,
+        "seconds": round(time.perf_counter() - t0, 1),
+    }
+    _results.write("navigate_hint", data, args.out, args.update_results)
+    print(render(data))
+    return 0
+
+
+def render(data: dict[str, Any]) -> str:
+    """The page fragment: success [interval] and path / oracle per split and policy."""
+    order = data["policies"]
+    splits = list(dict.fromkeys(r["split"] for r in data["rows"]))
+    by = {(r["split"], r["policy"]): r for r in data["rows"]}
+    lines = [
+        "| split | " + " | ".join(f"`{p}`" for p in order) + " |",
+        "|---|" + "---|" * len(order),
+    ]
+    for s in splits:
+        cells = []
+        for p in order:
+            r = by.get((s, p))
+            if r is None:
+                cells.append("–")
+                continue
+            lo, hi = r["ci95"]
+            cell = f"{r['successes'] / r['episodes']:.2f} [{lo:.2f}, {hi:.2f}]"
+            if r["path_ratio"] is not None:
+                cell += f", path {r['path_ratio']:.2f}×"
+            cells.append(cell)
+        lines.append(f"| {s} | " + " | ".join(cells) + " |")
+    n = data["rows"][0]["episodes"]
+    lines += [
+        "",
+        f"Success rate [95 % Wilson interval], {n} episodes per split from random starts "
+        "(distinct scene-start pairs), deterministic policies, one training seed each; path: "
+        "the mean path length over the episodes the policy and the oracle both solve, over the "
+        "oracle's.",
+        "",
+        f"Measured with `{data['command']}` ({data['seconds']} s).",
+    ]
+    return "\n".join(lines) + "\n"
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

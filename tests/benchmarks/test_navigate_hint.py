@@ -1,0 +1,29 @@
+"""``benchmarks.navigate_hint``: the path ratio over episodes both solve, and the fragment."""
+
+from __future__ import annotations
+
+from benchmarks import navigate_hint
+
+
+def _pol(success, path):
+    return {"per_episode": {"success": success, "path_length": path}}
+
+
+def test_path_ratio_counts_episodes_both_solve():
+    oracle = _pol([True, True, False, True], [2.0, 4.0, 9.0, 1.0])
+    pol = _pol([True, False, True, True], [3.0, 99.0, 1.0, 2.0])
+    assert navigate_hint.path_ratio(pol, oracle) == (3.0 + 2.0) / (2.0 + 1.0)
+    assert navigate_hint.path_ratio(_pol([False] * 4, [1.0] * 4), oracle) is None
+
+
+def test_fragment_shows_success_and_path():
+    rows = [
+        {"split": "test", "policy": "a", "successes": 9, "episodes": 10, "distinct": 10,
+         "ci95": [0.6, 0.98], "path_ratio": 1.25},
+        {"split": "test", "policy": "oracle", "successes": 10, "episodes": 10, "distinct": 10,
+         "ci95": [0.72, 1.0], "path_ratio": None},
+    ]  # fmt: skip
+    text = navigate_hint.render(
+        {"policies": ["a", "oracle"], "rows": rows, "command": "python -m x", "seconds": 1.0}
+    )
+    assert "| test | 0.90 [0.60, 0.98], path 1.25× | 1.00 [0.72, 1.00] |" in text
