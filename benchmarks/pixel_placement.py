@@ -45,6 +45,13 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--episodes", type=int, default=100)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--model", type=Path, default=MODEL, help="the pixel policy (.pt)")
+    ap.add_argument(
+        "--seed-models",
+        type=Path,
+        nargs="*",
+        default=[],
+        help="more training seeds of the same config (.pt): the IQM over all seeds per split",
+    )
     _results.add_output_args(ap, "pixel_placement")
     args = ap.parse_args(argv)
     t0 = time.perf_counter()
@@ -52,7 +59,7 @@ def main(argv: list[str] | None = None) -> int:
     with tempfile.TemporaryDirectory() as tmp:
         res = benchmark(
             ENV,
-            [str(args.model), str(PPO), "oracle"],
+            [str(args.model), *map(str, args.seed_models), str(PPO), "oracle"],
             episodes=args.episodes,
             seed=args.seed,
             split_names=["test", "ood", "real"],
@@ -63,8 +70,21 @@ def main(argv: list[str] | None = None) -> int:
     scenes = per_scene(args.model)
     names = {str(args.model): "pixel policy", str(PPO): "PPO (ppo_placement_random)"}
     rows = []
+    iqm = []
     for split, r in res["splits"].items():
+        for a in (r.get("iqm") or {}).values():
+            iqm.append(
+                {
+                    "split": split,
+                    "runs": a["n_runs"],
+                    "train_seeds": a["train_seeds"],
+                    "iqm": a["iqm"],
+                    "ci95": list(a["ci95"]),
+                }
+            )
         for p in r["policies"]:
+            if p["spec"] in map(str, args.seed_models):
+                continue  # in the IQM only
             rows.append(
                 {
                     "split": split,
@@ -84,6 +104,7 @@ def main(argv: list[str] | None = None) -> int:
             for k in ("command", "labelled_scenes", "solvable_fraction", "epochs", "wall_time_s")
         },
         "rows": rows,
+        "iqm": iqm,
         "scenes": scenes,
         "seconds": round(time.perf_counter() - t0, 1),
     }
@@ -155,6 +176,19 @@ def render(data: dict[str, Any]) -> str:
             cells.append(f"{r['successes'] / r['episodes']:.2f} [{lo:.2f}, {hi:.2f}]")
         d = next(by[(s, p)]["distinct"] for p in order if (s, p) in by)
         lines.append(f"| {s} | " + " | ".join(cells) + f" | {d} |")
+    if data.get("iqm"):
+        runs = data["iqm"][0]["runs"]
+        seeds = ", ".join(str(s) for s in data["iqm"][0]["train_seeds"])
+        lines += [
+            "",
+            f"The pixel policy's config over {runs} training seeds ({seeds}), IQM of the success "
+            "rate [95 % stratified-bootstrap interval]: "
+            + "; ".join(
+                f"{r['split']} {r['iqm']:.2f} [{r['ci95'][0]:.2f}, {r['ci95'][1]:.2f}]"
+                for r in data["iqm"]
+            )
+            + ".",
+        ]
     if data.get("scenes"):
         lines += [
             "",

@@ -29,6 +29,8 @@ def test_per_scene_counts_the_exact_labels(monkeypatch):
                  "distinct": 2, "ci95": [0.1, 0.9]},
             ],
             "scenes": rows,
+            "iqm": [{"split": "test", "runs": 5, "train_seeds": [0, 1, 2, 3, 4], "iqm": 0.9,
+                     "ci95": [0.8, 0.95]}],
             "training": {},
             "model": "m.pt",
             "command": "python -m benchmarks.pixel_placement",
@@ -36,3 +38,4 @@ def test_per_scene_counts_the_exact_labels(monkeypatch):
         }
     )  # fmt: skip
     assert "| ood:lab | 1 | 1 | 1 | 1 |" in text and "channel rule" in text
+    assert "over 5 training seeds (0, 1, 2, 3, 4)" in text and "test 0.90 [0.80, 0.95]" in text
