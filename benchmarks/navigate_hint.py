@@ -4,10 +4,9 @@ fixed hint rule and the oracle.
     python -m benchmarks.navigate_hint [--episodes 100] [--seed 0] [--models PATH ...]
 
 ``sensorplan benchmark --env sensorplan/Navigate-v0 --level hard --splits test ood real``
-(:func:`agents.evaluation.benchmark.benchmark`) of the shipped Navigate policies trained with
-``view_hint`` (``agents/pretrained/ppo_navigate_hint.zip``: PPO; ``ppo_navigate_residual.zip``:
-PPO correcting the hint rule, :mod:`agents.learning.residual`), the previous shipped
-``ppo_navigate_hard``, the hint rule (:mod:`agents.planning.hint_rule`, no learning) and the
+(:func:`agents.evaluation.benchmark.benchmark`) of the shipped Navigate policy trained with
+``view_hint`` (``agents/pretrained/ppo_navigate_hint.zip``, PPO), the one trained without it
+(``ppo_navigate_hard``), the hint rule (:mod:`agents.planning.hint_rule`, no learning) and the
 oracle, every policy on the same episode seeds from random starts.  Besides success it reports
 the mean path length over the episodes that the policy and the oracle both solve, as a
 multiple of the oracle's (issue 22's target: at most 1.3).  Needs the ``rl`` extra.
@@ -25,11 +24,7 @@ from . import _results
 
 ENV = "sensorplan/Navigate-v0"
 PRETRAINED = Path(__file__).resolve().parents[1] / "agents" / "pretrained"
-MODELS = [
-    PRETRAINED / "ppo_navigate_hint.zip",
-    PRETRAINED / "ppo_navigate_residual.zip",
-    PRETRAINED / "ppo_navigate_hard.zip",
-]
+MODELS = [PRETRAINED / "ppo_navigate_hint.zip", PRETRAINED / "ppo_navigate_hard.zip"]
 
 
 def path_ratio(policy: dict[str, Any], oracle: dict[str, Any]) -> float | None:

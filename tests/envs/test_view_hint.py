@@ -100,3 +100,20 @@ def test_hint_rule_is_a_policy_spec():
     with pytest.raises(ValueError, match="Navigate-v0"):
         HintRulePolicy(gym.make("sensorplan/Recognize-v0", scene="lab", view_hint=True,
                                 aim_features=True))  # fmt: skip
+
+
+def test_shipped_hint_policy_plays_with_its_observation():
+    """``agents/pretrained/ppo_navigate_hint.zip`` is played with the ``view_hint`` and
+    ``aim_features`` of its config on a bundled scene it never trained on, and recognizes."""
+    pytest.importorskip("stable_baselines3")
+    from pathlib import Path
+
+    from agents.evaluation.evaluate import evaluate
+
+    model = Path(__file__).resolve().parents[2] / "agents/pretrained/ppo_navigate_hint.zip"
+    res = evaluate(
+        "sensorplan/Navigate-v0", [str(model)], episodes=6,
+        env_kwargs={"scene": "lab", "random_start": True}, out=False, plot=False, verbose=False,
+    )  # fmt: skip
+    p = res["policies"][0]
+    assert p["play_env_kwargs"]["view_hint"] is True and p["successes"] >= 5
