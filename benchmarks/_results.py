@@ -55,6 +55,7 @@ NAMES = (
     "reference",
     "pixel_placement",
     "certified",
+    "navigate_hint",
 )
 
 
