@@ -40,23 +40,34 @@ def path_ratio(policy: dict[str, Any], oracle: dict[str, Any]) -> float | None:
     return num / den if den > 0 else None
 
 
-def main(argv: list[str] | None = None) -> int:
+def main(
+    argv: list[str] | None = None,
+    *,
+    env: str = ENV,
+    name: str = "navigate_hint",
+    models: list[Path] | None = None,
+    rules: tuple[str, ...] = ("hint-rule",),
+    doc: str = "",
+) -> int:
+    """Benchmark ``models`` (``--models``), the ``rules`` and the oracle on ``env``'s ``hard``
+    level and write the data as ``name``."""
     from agents.evaluation.benchmark import benchmark
     from agents.learning.policies import policy_label
 
     ap = argparse.ArgumentParser(
-        prog="python -m benchmarks.navigate_hint", description=__doc__.split("\n\n")[0]
+        prog=f"python -m benchmarks.{name}", description=(doc or __doc__).split("\n\n")[0]
     )
     ap.add_argument("--episodes", type=int, default=100)
     ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--models", type=Path, nargs="+", default=MODELS, help="model zips")
-    _results.add_output_args(ap, "navigate_hint")
+    ap.add_argument("--models", type=Path, nargs="+", default=models or MODELS, help="model zips")
+    _results.add_output_args(ap, name)
     args = ap.parse_args(argv)
     t0 = time.perf_counter()
-    specs = [str(m) for m in args.models] + ["hint-rule", "oracle"]
+    specs = [str(m) for m in args.models] + [*rules, "oracle"]
+    paths = env == ENV  # the path over the oracle's: Navigate's target
     with tempfile.TemporaryDirectory() as tmp:
         res = benchmark(
-            ENV,
+            env,
             specs,
             episodes=args.episodes,
             seed=args.seed,
@@ -77,17 +88,17 @@ def main(argv: list[str] | None = None) -> int:
                     "episodes": p["episodes"],
                     "distinct": p["distinct_episodes"],
                     "ci95": list(p["success_ci95"]),
-                    "path_ratio": None if p is oracle else path_ratio(p, oracle),
+                    "path_ratio": path_ratio(p, oracle) if paths and p is not oracle else None,
                 }
             )
     data: dict[str, Any] = {
-        "command": _results.command("benchmarks.navigate_hint", argv),
+        "command": _results.command(f"benchmarks.{name}", argv),
         "machine": _results.machine(),
         "policies": [policy_label(s) for s in specs],
         "rows": rows,
         "seconds": round(time.perf_counter() - t0, 1),
     }
-    _results.write("navigate_hint", data, args.out, args.update_results)
+    _results.write(name, data, args.out, args.update_results)
     print(render(data))
     return 0
 
@@ -115,12 +126,17 @@ def render(data: dict[str, Any]) -> str:
             cells.append(cell)
         lines.append(f"| {s} | " + " | ".join(cells) + " |")
     n = data["rows"][0]["episodes"]
+    paths = any(r["path_ratio"] is not None for r in data["rows"])
     lines += [
         "",
         f"Success rate [95 % Wilson interval], {n} episodes per split from random starts "
-        "(distinct scene-start pairs), deterministic policies, one training seed each; path: "
-        "the mean path length over the episodes the policy and the oracle both solve, over the "
-        "oracle's.",
+        "(distinct scene-start pairs), deterministic policies, one training seed each"
+        + (
+            "; path: the mean path length over the episodes the policy and the oracle both "
+            "solve, over the oracle's."
+            if paths
+            else "."
+        ),
         "",
         f"Measured with `{data['command']}` ({data['seconds']} s).",
     ]
