@@ -59,6 +59,15 @@ NAMES = (
 )
 
 
+def success_cell(row: dict[str, Any] | None) -> str:
+    """A table cell for a row with ``successes``, ``episodes`` and ``ci95``: the success rate
+    and its 95 % interval, ``"0.90 [0.82, 0.95]"`` (``"–"`` for ``None``)."""
+    if row is None:
+        return "–"
+    lo, hi = row["ci95"]
+    return f"{row['successes'] / row['episodes']:.2f} [{lo:.2f}, {hi:.2f}]"
+
+
 def add_output_args(ap: argparse.ArgumentParser, name: str) -> None:
     """Add ``--out DIR`` and ``--update-results`` to a benchmark's argument parser."""
     ap.add_argument(

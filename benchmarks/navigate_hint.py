@@ -116,12 +116,8 @@ def render(data: dict[str, Any]) -> str:
         cells = []
         for p in order:
             r = by.get((s, p))
-            if r is None:
-                cells.append("–")
-                continue
-            lo, hi = r["ci95"]
-            cell = f"{r['successes'] / r['episodes']:.2f} [{lo:.2f}, {hi:.2f}]"
-            if r["path_ratio"] is not None:
+            cell = _results.success_cell(r)
+            if r is not None and r["path_ratio"] is not None:
                 cell += f", path {r['path_ratio']:.2f}×"
             cells.append(cell)
         lines.append(f"| {s} | " + " | ".join(cells) + " |")

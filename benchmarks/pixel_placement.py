@@ -166,14 +166,7 @@ def render(data: dict[str, Any]) -> str:
         "|---|" + "---|" * (len(order) + 1),
     ]
     for s in splits:
-        cells = []
-        for p in order:
-            r = by.get((s, p))
-            if r is None:
-                cells.append("–")
-                continue
-            lo, hi = r["ci95"]
-            cells.append(f"{r['successes'] / r['episodes']:.2f} [{lo:.2f}, {hi:.2f}]")
+        cells = [_results.success_cell(by.get((s, p))) for p in order]
         d = next(by[(s, p)]["distinct"] for p in order if (s, p) in by)
         lines.append(f"| {s} | " + " | ".join(cells) + f" | {d} |")
     if data.get("iqm"):
