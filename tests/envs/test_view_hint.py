@@ -102,18 +102,25 @@ def test_hint_rule_is_a_policy_spec():
                                 aim_features=True))  # fmt: skip
 
 
-def test_shipped_hint_policy_plays_with_its_observation():
-    """``agents/pretrained/ppo_navigate_hint.zip`` is played with the ``view_hint`` and
-    ``aim_features`` of its config on a bundled scene it never trained on, and recognizes."""
+@pytest.mark.parametrize(
+    ("env_id", "name"),
+    [
+        ("sensorplan/Navigate-v0", "ppo_navigate_hint"),
+        ("sensorplan/Recognize-v0", "ppo_recognize_hint"),
+    ],
+)
+def test_shipped_hint_policies_play_with_their_observation(env_id, name):
+    """The shipped ``view_hint`` policies are played with the observation kwargs of their
+    configs (frame stacking too) on a bundled scene they never trained on, and succeed."""
     pytest.importorskip("stable_baselines3")
     from pathlib import Path
 
     from agents.evaluation.evaluate import evaluate
 
-    model = Path(__file__).resolve().parents[2] / "agents/pretrained/ppo_navigate_hint.zip"
+    model = Path(__file__).resolve().parents[2] / "agents" / "pretrained" / f"{name}.zip"
     res = evaluate(
-        "sensorplan/Navigate-v0", [str(model)], episodes=6,
-        env_kwargs={"scene": "lab", "random_start": True}, out=False, plot=False, verbose=False,
+        env_id, [str(model)], episodes=6, env_kwargs={"scene": "lab", "random_start": True},
+        out=False, plot=False, verbose=False,
     )  # fmt: skip
     p = res["policies"][0]
     assert p["play_env_kwargs"]["view_hint"] is True and p["successes"] >= 5
