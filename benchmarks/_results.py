@@ -56,6 +56,7 @@ NAMES = (
     "pixel_placement",
     "certified",
     "navigate_hint",
+    "recognize_hint",
 )
 
 
