@@ -204,7 +204,7 @@ def render(data: dict[str, Any]) -> str:
         f"seed. The pixel policy (`{data['model']}`) was trained with `{t.get('command')}`: "
         f"{t.get('labelled_scenes')} scenes labelled exactly in {wall.get('label')} s "
         f"({t.get('solvable_fraction', 0):.3f} of them have a right pixel action), "
-        f"{t.get('epochs')} epochs in {wall.get('fit')} s on 2 CPU cores.",
+        f"{t.get('epochs')} epochs in {wall.get('fit')} s on the 2-CPU machine.",
         "",
         f"Measured with `{data['command']}` ({data['seconds']} s).",
     ]
