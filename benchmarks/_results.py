@@ -38,6 +38,7 @@ NAMES = (
     "family_breakdown",
     "fuzz_contacts",
     "fuzz_swept",
+    "fuzz_certify",
     "oracle",
     "policies",
     "pool_build",
