@@ -541,3 +541,13 @@ def test_certified_bounds_skip_a_target_too_thin_for_cells():
     b = swept_bounds(s, recognizable=True)
     assert b.proven_inner is None and b.proven_hausdorff is None
     assert not b.outer.is_empty and b.hausdorff >= 0
+
+
+@pytest.mark.xfail(strict=True, reason="fuzz seed 300584 (benchmarks.fuzz_certify): open")
+def test_fuzz_seed_300584_stationary_partial_is_open():
+    """A placement 1e-2 D inside the stationary partial region (theta 0 at G) from which a
+    brute force with 20,000 samples per outline edge sees no outline point: a sliver,
+    collinear and flush contacts, a target vertex on a wall.  Not yet diagnosed; this test
+    starts passing (and then fails, strict) when it is fixed."""
+    found, _ = check_scene(fuzz_scene(300584, contacts=True), seed=300584)
+    assert not [f for f in found if f.kind == "unsafe"]
