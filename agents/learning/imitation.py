@@ -52,7 +52,7 @@ from stable_baselines3.common.policies import ActorCriticPolicy, BasePolicy
 import sensorplan_gym  # noqa: F401  (registers the env ids)
 
 from ..planning.oracle import OraclePolicy
-from .policies import algo_class
+from .policies import RULES, algo_class
 from .train import _activation
 from .vecenv import BatchedVecEnv
 
@@ -64,6 +64,7 @@ __all__ = [
     "dagger",
     "fit",
     "load_config",
+    "make_expert",
     "success_rate",
     "train_imitation",
 ]
@@ -220,6 +221,19 @@ class DaggerResult:
     history: list[dict[str, Any]] = field(default_factory=list)
 
 
+def make_expert(expert: str, venv: gym.vector.VectorEnv) -> Any:
+    """The labeller :func:`dagger` names: ``"oracle"`` (:class:`OraclePolicy` bound to
+    ``venv``) or a rule of :data:`~agents.learning.policies.RULES`; anything else raises
+    ``ValueError`` listing the choices."""
+    if expert == "oracle":
+        return OraclePolicy(venv)
+    if expert == "hint-rule":
+        from ..planning.hint_rule import HintRulePolicy
+
+        return HintRulePolicy(venv)
+    raise ValueError(f"expert must be 'oracle' or one of {', '.join(RULES)}, got {expert!r}")
+
+
 def dagger(
     venv: gym.vector.VectorEnv,
     policy: BasePolicy,
@@ -236,18 +250,22 @@ def dagger(
     max_pairs: int | None = None,
     deadline: float | None = None,
     log: Callable[[str], None] | None = None,
+    expert: str = "oracle",
 ) -> DaggerResult:
     """DAgger on the native vector env ``venv`` (reset with ``seed``): ``iterations`` rounds
     of :func:`collect` (``steps`` steps of every sub-environment with ``beta_i = beta0 *
     decay ** i``), aggregation, and :func:`fit` of ``policy`` on all pairs so far (the newest
     ``max_pairs`` when given).  ``deadline`` (``time.perf_counter()`` value): stop after the
-    iteration that passes it.  Returns a :class:`DaggerResult`."""
+    iteration that passes it.  ``expert``: who labels, ``"oracle"`` (the exact planner) or
+    a fixed rule of :data:`agents.learning.policies.RULES` (``"hint-rule"``: a function of
+    the observation, so a learner can fit its labels exactly).  Returns a
+    :class:`DaggerResult`."""
     if iterations < 1 or steps < 1:
         raise ValueError("dagger: iterations and steps must be positive")
     if not (0.0 <= beta0 <= 1.0 and 0.0 <= decay <= 1.0):
         raise ValueError(f"dagger: beta0 and decay must be in [0, 1], got {beta0}, {decay}")
     _check_policy(policy, loss)
-    oracle = OraclePolicy(venv)
+    oracle = make_expert(expert, venv)
     rng = np.random.default_rng(seed)
     obs, _ = venv.reset(seed=seed)
     xs: list[np.ndarray] = []
@@ -464,6 +482,7 @@ def train_imitation(
             max_pairs=d.get("max_pairs"),
             deadline=dl,
             log=log,
+            expert=str(cfg.get("expert", "oracle")),
         )
         record["imitation"] = res.history
         record["imitation_s"] = round(time.perf_counter() - t0, 1)

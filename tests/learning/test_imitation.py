@@ -219,3 +219,29 @@ def test_cli_dataset_record_and_imitate_entry(tmp_path, capsys):
         ]
     )
     assert rc == 0 and (tmp_path / "bc" / "final_model.zip").is_file()
+
+
+def test_dagger_from_the_hint_rule_fits_the_rule_labels():
+    """``expert="hint-rule"``: the labels are the rule's actions on the visited observations
+    (a function of the observation), and the fitted policy reproduces them; an unknown
+    expert is refused by name."""
+    from agents.learning.imitation import make_expert
+    from agents.planning.hint_rule import ENV_KWARGS, HintRulePolicy
+
+    kw = {**TINY, **ENV_KWARGS}
+    venv = gym.make_vec(NAV, num_envs=4, **kw)
+    assert isinstance(make_expert("hint-rule", venv), HintRulePolicy)
+    with pytest.raises(ValueError, match="expert must be 'oracle' or one of hint-rule"):
+        make_expert("teacher", venv)
+    model = _ppo(venv)
+    res = dagger(venv, model.policy, iterations=2, steps=24, epochs=30, seed=0, expert="hint-rule")
+    rule = HintRulePolicy(venv)
+    np.testing.assert_allclose(res.acts, rule.predict(res.obs)[0], atol=1e-6)
+    with torch.no_grad():
+        mine = model.policy._predict(torch.as_tensor(res.obs, dtype=torch.float32), True).numpy()
+    err = np.abs(np.clip(mine, -1, 1) - res.acts).mean()
+    untrained = np.abs(
+        np.clip(_ppo(venv).policy.predict(res.obs, deterministic=True)[0], -1, 1) - res.acts
+    ).mean()
+    assert err < 0.5 * untrained, (err, untrained)
+    venv.close()
