@@ -70,6 +70,24 @@ def success_cell(row: dict[str, Any] | None) -> str:
     return f"{row['successes'] / row['episodes']:.2f} [{lo:.2f}, {hi:.2f}]"
 
 
+def iqm_rows(res: dict[str, Any]) -> list[dict[str, Any]]:
+    """Per split and per config trained at several seeds, the IQM of the success rate over
+    the seeds with its stratified-bootstrap 95 % interval, from the result of
+    :func:`agents.evaluation.benchmark.benchmark`."""
+    return [
+        {
+            "split": split,
+            "config": name,
+            "runs": a["n_runs"],
+            "train_seeds": a["train_seeds"],
+            "iqm": a["iqm"],
+            "ci95": list(a["ci95"]),
+        }
+        for split, r in res["splits"].items()
+        for name, a in (r.get("iqm") or {}).items()
+    ]
+
+
 def add_output_args(ap: argparse.ArgumentParser, name: str) -> None:
     """Add ``--out DIR`` and ``--update-results`` to a benchmark's argument parser."""
     ap.add_argument(

@@ -60,10 +60,19 @@ def main(
     ap.add_argument("--episodes", type=int, default=100)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--models", type=Path, nargs="+", default=models or MODELS, help="model zips")
+    ap.add_argument(
+        "--seed-models",
+        type=Path,
+        nargs="*",
+        default=[],
+        help="more training seeds of the first model's config (zips): the IQM over all its "
+        "seeds per split, and each seed's path ratio",
+    )
     _results.add_output_args(ap, name)
     args = ap.parse_args(argv)
     t0 = time.perf_counter()
-    specs = [str(m) for m in args.models] + [*rules, "oracle"]
+    extra = [str(m) for m in args.seed_models]
+    specs = [str(m) for m in args.models] + extra + [*rules, "oracle"]
     paths = env == ENV  # the path over the oracle's: Navigate's target
     with tempfile.TemporaryDirectory() as tmp:
         res = benchmark(
@@ -76,10 +85,22 @@ def main(
             out=tmp,
             verbose=False,
         )
-    rows = []
+    rows, seeds = [], []
     for split, r in res["splits"].items():
         oracle = next(p for p in r["policies"] if p["spec"] == "oracle")
         for p in r["policies"]:
+            if extra and p["spec"] in (specs[0], *extra):  # every seed of the first config
+                seeds.append(
+                    {
+                        "split": split,
+                        "policy": policy_label(p["spec"]),
+                        "train_seed": p.get("train_seed"),
+                        "success_rate": p["success_rate"],
+                        "path_ratio": path_ratio(p, oracle) if paths else None,
+                    }
+                )
+            if p["spec"] in extra:
+                continue  # in the seeds' summary only
             rows.append(
                 {
                     "split": split,
@@ -94,8 +115,10 @@ def main(
     data: dict[str, Any] = {
         "command": _results.command(f"benchmarks.{name}", argv),
         "machine": _results.machine(),
-        "policies": [policy_label(s) for s in specs],
+        "policies": [policy_label(s) for s in specs if s not in extra],
         "rows": rows,
+        "iqm": _results.iqm_rows(res) if extra else [],
+        "seeds": seeds,
         "seconds": round(time.perf_counter() - t0, 1),
     }
     _results.write(name, data, args.out, args.update_results)
@@ -136,6 +159,32 @@ def render(data: dict[str, Any]) -> str:
         "",
         f"Measured with `{data['command']}` ({data['seconds']} s).",
     ]
+    if data.get("iqm"):
+        first = order[0]
+        by_split: dict[str, list[dict[str, Any]]] = {}
+        for r in data["seeds"]:
+            by_split.setdefault(r["split"], []).append(r)
+        iqm = {r["split"]: r for r in data["iqm"] if len(by_split.get(r["split"], [])) == r["runs"]}
+        some = next(iter(iqm.values()))
+        lines += [
+            "",
+            f"`{first}`'s recipe over {some['runs']} training seeds "
+            f"({', '.join(str(x) for x in some['train_seeds'])}): the IQM of the success rate "
+            "[95 % stratified-bootstrap interval], each seed's success and path ratio:",
+            "",
+            "| split | IQM | per seed: success | per seed: path / oracle |",
+            "|---|---|---|---|",
+        ]
+        for s in splits:
+            if s not in iqm:
+                continue
+            a, per = iqm[s], sorted(by_split[s], key=lambda r: str(r["train_seed"]))
+            succ = " ".join(f"{r['success_rate']:.2f}" for r in per)
+            path = " ".join(
+                "–" if r["path_ratio"] is None else f"{r['path_ratio']:.2f}×" for r in per
+            )
+            ci = f"[{a['ci95'][0]:.2f}, {a['ci95'][1]:.2f}]"
+            lines.append(f"| {s} | {a['iqm']:.2f} {ci} | {succ} | {path} |")
     return "\n".join(lines) + "\n"
 
 

@@ -70,18 +70,8 @@ def main(argv: list[str] | None = None) -> int:
     scenes = per_scene(args.model)
     names = {str(args.model): "pixel policy", str(PPO): "PPO (ppo_placement_random)"}
     rows = []
-    iqm = []
+    iqm = _results.iqm_rows(res)
     for split, r in res["splits"].items():
-        for a in (r.get("iqm") or {}).values():
-            iqm.append(
-                {
-                    "split": split,
-                    "runs": a["n_runs"],
-                    "train_seeds": a["train_seeds"],
-                    "iqm": a["iqm"],
-                    "ci95": list(a["ci95"]),
-                }
-            )
         for p in r["policies"]:
             if p["spec"] in map(str, args.seed_models):
                 continue  # in the IQM only

@@ -284,6 +284,10 @@ def evaluate(
                 meta.update(
                     {
                         "algo": cfg.get("algo") or type(policy).__name__.lower(),
+                        # sensorplan imitate's method (bc, dagger, dagger+ppo): seeds of
+                        # different methods are different configs
+                        "method": cfg.get("method"),
+                        "expert": (cfg.get("config") or {}).get("expert"),
                         "train_seed": cfg.get("seed"),
                         "train_env_kwargs": cfg.get("env_kwargs"),
                         "play_env_kwargs": play_kwargs,
@@ -343,7 +347,10 @@ def evaluate(
     for p in results["policies"]:
         if p["kind"] == "model":
             kw = json.dumps(p.get("train_env_kwargs") or {}, sort_keys=True)
-            by_config[(p["algo"], kw)].append(p)
+            name = "+".join(
+                str(x) for x in (p["algo"], p.get("method"), p.get("expert")) if x is not None
+            )
+            by_config[(name, kw)].append(p)
     n_configs = defaultdict(int)
     for algo, _ in by_config:
         n_configs[algo] += 1

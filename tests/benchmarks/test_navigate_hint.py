@@ -27,3 +27,23 @@ def test_fragment_shows_success_and_path():
         {"policies": ["a", "oracle"], "rows": rows, "command": "python -m x", "seconds": 1.0}
     )
     assert "| test | 0.90 [0.60, 0.98], path 1.25× | 1.00 [0.72, 1.00] |" in text
+
+
+def test_fragment_shows_the_iqm_over_seeds_and_each_seeds_path():
+    rows = [
+        {"split": "test", "policy": "a", "successes": 9, "episodes": 10, "distinct": 10,
+         "ci95": [0.6, 0.98], "path_ratio": 1.25},
+    ]  # fmt: skip
+    seeds = [
+        {"split": "test", "policy": n, "train_seed": s, "success_rate": r, "path_ratio": p}
+        for n, s, r, p in (("a", 0, 0.9, 1.25), ("a1", 1, 0.8, 1.1), ("a2", 2, None, None))
+    ]
+    seeds[2]["success_rate"] = 0.7
+    iqm = [{"split": "test", "config": "ppo+dagger", "runs": 3, "train_seeds": [0, 1, 2],
+            "iqm": 0.8, "ci95": [0.7, 0.9]}]  # fmt: skip
+    text = navigate_hint.render(
+        {"policies": ["a"], "rows": rows, "iqm": iqm, "seeds": seeds, "command": "python -m x",
+         "seconds": 1.0}
+    )  # fmt: skip
+    assert "`a`'s recipe over 3 training seeds (0, 1, 2)" in text
+    assert "| test | 0.80 [0.70, 0.90] | 0.90 0.80 0.70 | 1.25× 1.10× – |" in text

@@ -260,19 +260,24 @@ def test_evaluate_function_iqm_over_training_seeds(tiny_run, tmp_path):
     import shutil
 
     # two copies of the tiny model, recorded as different training seeds
+    # and two more recorded as `sensorplan imitate` DAgger runs (the same algo and env
+    # kwargs, another method): a config of their own, not a third and fourth PPO seed
     specs = []
-    for s in (11, 12):
-        d = tmp_path / f"seed{s}"
+    for s, method in ((11, None), (12, None), (11, "dagger"), (12, "dagger")):
+        d = tmp_path / f"seed{s}{method or ''}"
         d.mkdir()
         shutil.copyfile(tiny_run["best_model"], d / "best_model.zip")
         cfg = model_config(tiny_run["best_model"])
         cfg["seed"] = s
+        if method:
+            cfg.update(method=method, config={"expert": "hint-rule"})
         (d / "best_model.yaml").write_text(yaml.safe_dump(cfg))
         specs.append(str(d / "best_model.zip"))
     res = evaluate(NAV, specs, episodes=2, seed=0, out=False, verbose=False)
-    assert [p["train_seed"] for p in res["policies"]] == [11, 12]
-    a = res["iqm"]["ppo"]
-    assert a["n_runs"] == 2 and a["ci95"][0] <= a["iqm"] <= a["ci95"][1]
+    assert [p["train_seed"] for p in res["policies"]] == [11, 12, 11, 12]
+    assert set(res["iqm"]) == {"ppo", "ppo+dagger+hint-rule"}
+    for a in res["iqm"].values():
+        assert a["n_runs"] == 2 and a["ci95"][0] <= a["iqm"] <= a["ci95"][1]
     assert res["files"] == {}
 
 
