@@ -24,7 +24,11 @@ from . import _results
 
 ENV = "sensorplan/Navigate-v0"
 PRETRAINED = Path(__file__).resolve().parents[1] / "agents" / "pretrained"
-MODELS = [PRETRAINED / "ppo_navigate_hint.zip", PRETRAINED / "ppo_navigate_hard.zip"]
+MODELS = [
+    PRETRAINED / "dagger_navigate_hint.zip",
+    PRETRAINED / "ppo_navigate_hint.zip",
+    PRETRAINED / "ppo_navigate_hard.zip",
+]
 
 
 def path_ratio(policy: dict[str, Any], oracle: dict[str, Any]) -> float | None:
@@ -150,6 +154,7 @@ def render(data: dict[str, Any]) -> str:
         "",
         f"Success rate [95 % Wilson interval], {n} episodes per split from random starts "
         "(distinct scene-start pairs), deterministic policies, one training seed each"
+        + (" (more seeds of the first: below)" if data.get("iqm") else "")
         + (
             "; path: the mean path length over the episodes the policy and the oracle both "
             "solve, over the oracle's."

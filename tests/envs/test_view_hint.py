@@ -106,6 +106,7 @@ def test_hint_rule_is_a_policy_spec():
     ("env_id", "name"),
     [
         ("sensorplan/Navigate-v0", "ppo_navigate_hint"),
+        ("sensorplan/Navigate-v0", "dagger_navigate_hint"),
         ("sensorplan/Recognize-v0", "ppo_recognize_hint"),
     ],
 )
