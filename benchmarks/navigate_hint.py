@@ -175,10 +175,11 @@ def render(data: dict[str, Any]) -> str:
             "",
             f"`{first}`'s recipe over {some['runs']} training seeds "
             f"({', '.join(str(x) for x in some['train_seeds'])}): the IQM of the success rate "
-            "[95 % stratified-bootstrap interval], each seed's success and path ratio:",
+            "[95 % stratified-bootstrap interval], each seed's success"
+            + (" and path ratio:" if paths else ":"),
             "",
-            "| split | IQM | per seed: success | per seed: path / oracle |",
-            "|---|---|---|---|",
+            "| split | IQM | per seed: success |" + (" per seed: path / oracle |" if paths else ""),
+            "|---|---|---|" + ("---|" if paths else ""),
         ]
         for s in splits:
             if s not in iqm:
@@ -189,7 +190,9 @@ def render(data: dict[str, Any]) -> str:
                 "–" if r["path_ratio"] is None else f"{r['path_ratio']:.2f}×" for r in per
             )
             ci = f"[{a['ci95'][0]:.2f}, {a['ci95'][1]:.2f}]"
-            lines.append(f"| {s} | {a['iqm']:.2f} {ci} | {succ} | {path} |")
+            lines.append(
+                f"| {s} | {a['iqm']:.2f} {ci} | {succ} |" + (f" {path} |" if paths else "")
+            )
     return "\n".join(lines) + "\n"
 
 

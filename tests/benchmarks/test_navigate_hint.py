@@ -47,3 +47,11 @@ def test_fragment_shows_the_iqm_over_seeds_and_each_seeds_path():
     )  # fmt: skip
     assert "`a`'s recipe over 3 training seeds (0, 1, 2)" in text
     assert "| test | 0.80 [0.70, 0.90] | 0.90 0.80 0.70 | 1.25× 1.10× – |" in text
+    # Recognize (no path target): the seeds' table has no path column
+    for r in (*rows, *seeds):
+        r["path_ratio"] = None
+    text = navigate_hint.render(
+        {"policies": ["a"], "rows": rows, "iqm": iqm, "seeds": seeds, "command": "python -m x",
+         "seconds": 1.0}
+    )  # fmt: skip
+    assert "| test | 0.80 [0.70, 0.90] | 0.90 0.80 0.70 |\n" in text and "path" not in text
