@@ -82,6 +82,7 @@ def iqm_rows(res: dict[str, Any]) -> list[dict[str, Any]]:
             "train_seeds": a["train_seeds"],
             "iqm": a["iqm"],
             "ci95": list(a["ci95"]),
+            "policies": list(a.get("policies") or []),
         }
         for split, r in res["splits"].items()
         for name, a in (r.get("iqm") or {}).items()

@@ -69,8 +69,8 @@ def main(
         type=Path,
         nargs="*",
         default=[],
-        help="more training seeds of the first model's config (zips): the IQM over all its "
-        "seeds per split, and each seed's path ratio",
+        help="more training seeds of the --models' configs (zips): per config trained at "
+        "several seeds, the IQM over its seeds per split, and each seed's path ratio",
     )
     _results.add_output_args(ap, name)
     args = ap.parse_args(argv)
@@ -89,14 +89,17 @@ def main(
             out=tmp,
             verbose=False,
         )
+    iqm = _results.iqm_rows(res)
+    group = {(r["split"], n): r["config"] for r in iqm for n in r["policies"]}
     rows, seeds = [], []
     for split, r in res["splits"].items():
         oracle = next(p for p in r["policies"] if p["spec"] == "oracle")
         for p in r["policies"]:
-            if extra and p["spec"] in (specs[0], *extra):  # every seed of the first config
+            if (split, p["name"]) in group:  # one of the seeds of a config
                 seeds.append(
                     {
                         "split": split,
+                        "config": group[(split, p["name"])],
                         "policy": policy_label(p["spec"]),
                         "train_seed": p.get("train_seed"),
                         "success_rate": p["success_rate"],
@@ -121,7 +124,7 @@ def main(
         "machine": _results.machine(),
         "policies": [policy_label(s) for s in specs if s not in extra],
         "rows": rows,
-        "iqm": _results.iqm_rows(res) if extra else [],
+        "iqm": iqm,
         "seeds": seeds,
         "seconds": round(time.perf_counter() - t0, 1),
     }
@@ -164,36 +167,40 @@ def render(data: dict[str, Any]) -> str:
         "",
         f"Measured with `{data['command']}` ({data['seconds']} s).",
     ]
-    if data.get("iqm"):
-        first = order[0]
-        by_split: dict[str, list[dict[str, Any]]] = {}
-        for r in data["seeds"]:
-            by_split.setdefault(r["split"], []).append(r)
-        iqm = {r["split"]: r for r in data["iqm"] if len(by_split.get(r["split"], [])) == r["runs"]}
-        some = next(iter(iqm.values()))
-        lines += [
-            "",
-            f"`{first}`'s recipe over {some['runs']} training seeds "
-            f"({', '.join(str(x) for x in some['train_seeds'])}): the IQM of the success rate "
-            "[95 % stratified-bootstrap interval], each seed's success"
-            + (" and path ratio:" if paths else ":"),
-            "",
-            "| split | IQM | per seed: success |" + (" per seed: path / oracle |" if paths else ""),
-            "|---|---|---|" + ("---|" if paths else ""),
-        ]
-        for s in splits:
-            if s not in iqm:
-                continue
-            a, per = iqm[s], sorted(by_split[s], key=lambda r: str(r["train_seed"]))
-            succ = " ".join(f"{r['success_rate']:.2f}" for r in per)
-            path = " ".join(
-                "–" if r["path_ratio"] is None else f"{r['path_ratio']:.2f}×" for r in per
-            )
-            ci = f"[{a['ci95'][0]:.2f}, {a['ci95'][1]:.2f}]"
-            lines.append(
-                f"| {s} | {a['iqm']:.2f} {ci} | {succ} |" + (f" {path} |" if paths else "")
-            )
+    for config in dict.fromkeys(r.get("config") for r in data.get("iqm") or []):
+        lines += ["", *_seeds_table(data, config, splits, paths)]
     return "\n".join(lines) + "\n"
+
+
+def _seeds_table(data: dict[str, Any], config: Any, splits: list[str], paths: bool) -> list[str]:
+    """The IQM over the training seeds of one config per split, and each seed's success (and
+    path ratio), named after the first of its policies in the main table."""
+    iqm = {r["split"]: r for r in data["iqm"] if r.get("config") == config}
+    per: dict[str, list[dict[str, Any]]] = {}
+    for r in data["seeds"]:
+        if r.get("config", config) == config:
+            per.setdefault(r["split"], []).append(r)
+    some = next(iter(iqm.values()))
+    shown = [p for p in data["policies"] if any(r["policy"] == p for v in per.values() for r in v)]
+    name = shown[0] if shown else str(config)
+    lines = [
+        f"`{name}`'s recipe over {some['runs']} training seeds "
+        f"({', '.join(str(x) for x in some['train_seeds'])}): the IQM of the success rate "
+        "[95 % stratified-bootstrap interval], each seed's success"
+        + (" and path ratio:" if paths else ":"),
+        "",
+        "| split | IQM | per seed: success |" + (" per seed: path / oracle |" if paths else ""),
+        "|---|---|---|" + ("---|" if paths else ""),
+    ]
+    for s in splits:
+        if s not in iqm or len(per.get(s, [])) != iqm[s]["runs"]:
+            continue
+        a, rs = iqm[s], sorted(per[s], key=lambda r: str(r["train_seed"]))
+        succ = " ".join(f"{r['success_rate']:.2f}" for r in rs)
+        path = " ".join("–" if r["path_ratio"] is None else f"{r['path_ratio']:.2f}×" for r in rs)
+        ci = f"[{a['ci95'][0]:.2f}, {a['ci95'][1]:.2f}]"
+        lines.append(f"| {s} | {a['iqm']:.2f} {ci} | {succ} |" + (f" {path} |" if paths else ""))
+    return lines
 
 
 if __name__ == "__main__":
