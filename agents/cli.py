@@ -211,7 +211,9 @@ def build_parser() -> argparse.ArgumentParser:
         "--splits",
         nargs="+",
         default=None,
-        help="train, test, ood, ood:<scene>, real, real:<map> (default: train test ood)",
+        help="train, test, ood, ood:<scene>, real, real:<map>, narrow (the bundled scenes "
+        "and real maps with a 60-90 degree sensor), narrow:<scene or map> "
+        "(default: train test ood)",
     )
     bm.add_argument("--env-kwargs", type=_json_dict, default=None)
     bm.add_argument(

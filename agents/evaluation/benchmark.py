@@ -21,7 +21,12 @@ Procedural splits of tasks with a start (Navigate, Recognize) draw a start per e
   drawn per episode (``random_start=True``) where the task has one;
 * ``real`` -- every bundled real floor plan (:data:`sensorplan_gym.REAL_SCENES`, public ROS
   maps of the Willow Garage office and the LSE arena), one split each (``real:willow_north``
-  ...); not in the default splits (give ``--splits train test ood real``).
+  ...); not in the default splits (give ``--splits train test ood real``);
+* ``narrow`` -- the bundled scenes and real maps with a narrow sensor: each at the narrowest
+  of 60°, 75° and 90° from which some pose of its recognizable region keeps both swept hulls
+  in view (:data:`NARROW_FOV_DEG`, the scene's own field of view replaced; ``warehouse`` has
+  none up to 120°), one split each (``narrow:lab`` ...): the narrow-field-of-view rooms that
+  policies trained on full circles fail; not in the default splits.
 
 The difficulty knob ``--difficulty D`` (default :data:`DEFAULT_DIFFICULTY`) is the env kwarg
 ``min_start_distance``: procedural scenes start at least ``D`` scene diameters away from the
@@ -105,6 +110,19 @@ def training_pool(policies: list[str]) -> dict | None:
     return json.loads(next(iter(pools))) if pools else None
 
 
+#: the field of view (degrees) of each ``narrow`` split: per scene the narrowest of 60, 75 and
+#: 90 at which the oracle finds a recognizing pose (``agents.planning.oracle.plan_viewpoint``;
+#: tested); ``lab`` at 60 and ``corridor`` at 75 have none, ``warehouse`` none up to 120
+NARROW_FOV_DEG = {
+    "edr": 60.0,
+    "lab": 75.0,
+    "corridor": 90.0,
+    "real/lse_arena": 60.0,
+    "real/willow_north": 60.0,
+    "real/willow_south": 60.0,
+}
+
+
 def splits(
     names: list[str],
     difficulty: float | None,
@@ -150,11 +168,24 @@ def splits(
             out[name] = {"scene": name[4:], **start}
         elif name.startswith("real:") and f"real/{name[5:]}" in REAL_SCENES:
             out[name] = {"scene": f"real/{name[5:]}", **start}
+        elif name == "narrow":
+            for scene, fov in NARROW_FOV_DEG.items():
+                out[f"narrow:{scene.removeprefix('real/')}"] = {
+                    "scene": scene,
+                    "fov_deg": fov,
+                    **start,
+                }
+        elif name.startswith("narrow:") and (
+            name[7:] in NARROW_FOV_DEG or f"real/{name[7:]}" in NARROW_FOV_DEG
+        ):
+            scene = name[7:] if name[7:] in NARROW_FOV_DEG else f"real/{name[7:]}"
+            out[name] = {"scene": scene, "fov_deg": NARROW_FOV_DEG[scene], **start}
         else:
             raise ValueError(
                 f"unknown split {name!r}: use train, test, ood, ood:<scene> "
                 f"({', '.join(BUNDLED_SCENES)}), real or real:<map> "
-                f"({', '.join(s[5:] for s in REAL_SCENES)})"
+                f"({', '.join(s[5:] for s in REAL_SCENES)}), narrow or narrow:<scene or map> "
+                f"({', '.join(s.removeprefix('real/') for s in NARROW_FOV_DEG)})"
             )
     return out
 

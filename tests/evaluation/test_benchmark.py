@@ -161,3 +161,29 @@ def test_level_draws_the_procedural_splits_from_its_family(tmp_path):
             verbose=False,
         )
     assert not (tmp_path / "never").exists()
+
+
+def test_narrow_splits_replace_the_scenes_field_of_view(tmp_path):
+    """``narrow``: the bundled scenes and real maps with a narrow sensor (the issue's lab-like
+    room with a narrow field of view), each at the narrowest of 60/75/90 degrees from which
+    the oracle finds a recognizing pose; the env plays that sensor and the oracle recognizes."""
+    from agents.evaluation.benchmark import NARROW_FOV_DEG
+    from agents.planning.oracle import plan_viewpoint
+
+    sp = splits(["narrow"], None, needs_start=True)
+    assert set(sp) == {"narrow:lab", "narrow:edr", "narrow:corridor", "narrow:lse_arena",
+                       "narrow:willow_north", "narrow:willow_south"}  # fmt: skip
+    assert sp["narrow:willow_north"]["scene"] == "real/willow_north"
+    assert sp["narrow:lab"]["fov_deg"] == 75.0 and sp["narrow:edr"]["fov_deg"] == 60.0
+    with pytest.raises(ValueError, match="narrow:<scene or map>"):
+        splits(["narrow:warehouse"], None, True)
+    # every scene has a recognizing pose at its field of view; lab's 75 is the narrowest
+    cases = [("lab", 60.0, "no_placement"), *((s, f, "ok") for s, f in NARROW_FOV_DEG.items())]
+    for scene, fov, status in cases:
+        env = gym.make("sensorplan/Navigate-v0", scene=scene, fov_deg=fov)
+        _, info = env.reset(seed=0)
+        assert env.unwrapped.world.fov == pytest.approx(np.radians(fov))
+        assert plan_viewpoint(env.unwrapped.world, np.array(info["pose"][:2])).status == status
+    res = benchmark("sensorplan/Navigate-v0", ["oracle"], episodes=2, split_names=["narrow:lab"],
+                    out=tmp_path, verbose=False)  # fmt: skip
+    assert res["rows"][0]["success_rate"] == 1.0
