@@ -2,14 +2,17 @@
 fixed hint rule and the oracle.
 
     python -m benchmarks.navigate_hint [--episodes 100] [--seed 0] [--models PATH ...]
+        [--seed-models PATH ...]
 
-``sensorplan benchmark --env sensorplan/Navigate-v0 --level hard --splits test ood real``
-(:func:`agents.evaluation.benchmark.benchmark`) of the shipped Navigate policy trained with
-``view_hint`` (``agents/pretrained/ppo_navigate_hint.zip``, PPO), the one trained without it
-(``ppo_navigate_hard``), the hint rule (:mod:`agents.planning.hint_rule`, no learning) and the
-oracle, every policy on the same episode seeds from random starts.  Besides success it reports
-the mean path length over the episodes that the policy and the oracle both solve, as a
-multiple of the oracle's (issue 22's target: at most 1.3).  Needs the ``rl`` extra.
+``sensorplan benchmark --env sensorplan/Navigate-v0 --level hard --splits test ood real narrow``
+(:func:`agents.evaluation.benchmark.benchmark`) of the shipped Navigate policies that read
+``view_hint`` (``agents/pretrained/dagger_navigate_hint.zip``, DAgger from the hint rule, and
+``ppo_navigate_hint.zip``, PPO), the one trained without it (``ppo_navigate_hard``), the hint
+rule (:mod:`agents.planning.hint_rule`, no learning) and the oracle, every policy on the same
+episode seeds from random starts.  Besides success it reports the mean path length over the
+episodes that the policy and the oracle both solve, as a multiple of the oracle's (issue 22's
+target: at most 1.3).  ``--seed-models``: more training seeds of the ``--models``' configs;
+per config trained at several seeds, the IQM over its seeds.  Needs the ``rl`` extra.
 """
 
 from __future__ import annotations
@@ -84,7 +87,7 @@ def main(
             specs,
             episodes=args.episodes,
             seed=args.seed,
-            split_names=["test", "ood", "real"],
+            split_names=["test", "ood", "real", "narrow"],
             level="hard",
             out=tmp,
             verbose=False,

@@ -3,7 +3,7 @@ trained without it and the oracle.
 
     python -m benchmarks.recognize_hint [--episodes 100] [--seed 0] [--models PATH ...]
 
-``sensorplan benchmark --env sensorplan/Recognize-v0 --level hard --splits test ood real`` of
+``sensorplan benchmark --env sensorplan/Recognize-v0 --level hard --splits test ood real narrow`` of
 ``agents/pretrained/ppo_recognize_hint.zip`` (PPO with 4 stacked frames, ``view_hint`` and
 ``aim_features``), ``ppo_recognize_hard`` (the same recipe without them) and the oracle, every
 policy on the same episode seeds from random starts (:mod:`benchmarks.navigate_hint`, whose
