@@ -301,9 +301,11 @@ def build_parser() -> argparse.ArgumentParser:
     im = sub.add_parser(
         "imitate",
         help="learn from the oracle: bc, dagger, dagger+ppo (or ppo from scratch)",
-        description="Behaviour cloning / DAgger on the batched env with the oracle as the "
-        "expert, optionally followed by PPO fine-tuning; hyperparameters from "
-        "agents/configs/imitation.yaml (see agents/learning/imitation.py).",
+        description="Behaviour cloning / DAgger on the batched env with the oracle (or, "
+        "config key expert: hint-rule, the fixed rule on view_hint) as the expert, optionally "
+        "followed by PPO fine-tuning; hyperparameters from agents/configs/imitation.yaml "
+        "(see agents/learning/imitation.py; agents/configs/imitation_hint.yaml trains the "
+        "shipped dagger_navigate_hint).",
     )
     im.add_argument(
         "--env",
