@@ -115,9 +115,16 @@ def _complete(scene: Scene, spec: TargetSpec) -> shapely.Geometry:
     if len(wedges):
         # A wedge side bounds the region only if the obstacle stays on one side of
         # it at u (otherwise the tangent enters the obstacle right at u).
+        # A corner touching K has the lines of K's own edges as sides: an obstacle edge
+        # flush with a hull edge within the scene's tolerance can end several tol off that
+        # line (fuzz seed 301059: 1.7 tol at 0.32 long, the edges 1e-8 apart all along), so
+        # there a neighbour within NEAR_REL tol of the line counts as on it (keeping the
+        # wedge is the conservative choice).
         prev, nxt = dom.vert_prev[dom.reflex], dom.vert_next[dom.reflex]
         tol = 1e-9 * dom.scale
-        wedges = wedges[_grazes(u, k_lo, prev, nxt, tol) | _grazes(u, k_hi, prev, nxt, tol)]
+        touch = _touching_cones(u, spec.hull_pts, spec.radius, tol)[0]
+        t_u = np.where(touch, NEAR_REL * tol, tol)
+        wedges = wedges[_grazes(u, k_lo, prev, nxt, t_u) | _grazes(u, k_hi, prev, nxt, t_u)]
     if len(wedges):
         shapely.prepare(vis)
         wedges = wedges[shapely.intersects(vis, wedges)]
@@ -313,12 +320,12 @@ def _tangent_point(u: np.ndarray, ang: np.ndarray, k: np.ndarray, radius: float)
 
 
 def _grazes(
-    u: np.ndarray, k: np.ndarray, prev: np.ndarray, nxt: np.ndarray, tol: float = 0.0
+    u: np.ndarray, k: np.ndarray, prev: np.ndarray, nxt: np.ndarray, tol: float | np.ndarray = 0.0
 ) -> np.ndarray:
     """True where the line through ``u`` and ``k`` has both ring neighbours of
-    ``u`` on the same (closed) side.  A neighbour within ``tol`` of the line counts
-    as on it (an obstacle flush on a hull edge, touching within the scene's
-    tolerance: keeping the wedge is the conservative choice)."""
+    ``u`` on the same (closed) side.  A neighbour within ``tol`` (a scalar or one per
+    point) of the line counts as on it (an obstacle flush on a hull edge, touching within
+    the scene's tolerance: keeping the wedge is the conservative choice)."""
     d = k - u
     ln = np.hypot(d[:, 0], d[:, 1])
     a = d[:, 0] * (prev - u)[:, 1] - d[:, 1] * (prev - u)[:, 0]

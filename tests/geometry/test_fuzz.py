@@ -580,14 +580,33 @@ def test_fuzz_seed_300584_member_sees_through_a_pinhole():
     assert not partial_region(s2, target_at=q0).contains(shapely.Point(p))
 
 
-@pytest.mark.xfail(strict=True, reason="fuzz seed 301059 (benchmarks.fuzz_certify): open")
-def test_fuzz_seed_301059_stationary_complete_is_open():
-    """Fuzz seed 301059: members of the stationary complete region (theta 0 at G) from
-    which CGAL's visibility polygon misses a sliver of the target (5.8e-3 of 0.50 in area
-    from a member 0.5 units inside).  An obstacle is flush with the target's left edge and
-    shares its two vertices; from the upper left, sight lines to the target's interior
-    next to that edge cross the obstacle.  The wedge of the shared vertex (the tangent cone
-    of K there) should hold those members.  Not yet fixed; this test starts passing (and
-    then fails, strict) when it is."""
-    found, _ = check_scene(fuzz_scene(301059, contacts=True), seed=301059)
-    assert not [f for f in found if f.kind == "unsafe"]
+def test_fuzz_seed_301059_flush_obstacle_keeps_its_wedge():
+    """Fuzz seed 301059 (``benchmarks.fuzz_certify``): an obstacle flush with the target's
+    left edge, sharing its two vertices within the tolerance, its far corner 1.7 tol off
+    the hull edge's line.  The shared corner's wedge (the tangent cone of K there) was
+    dropped as "entering the obstacle", and members of the stationary complete region
+    missed a sliver of the target: CGAL's visibility polygon from one, 0.5 units inside,
+    left 5.8e-3 of the target's 0.50 uncovered.  Now every sampled member sees the whole
+    target by CGAL, and the fuzz check is clean."""
+    pytest.importorskip("pyvispoly")
+    try:
+        from tests.oracle import VisOracle
+    except ImportError:
+        from oracle import VisOracle  # type: ignore[no-redef]
+    import numpy as np
+
+    from geometry import complete_region
+    from geometry.fuzz import _sample
+
+    d = fuzz_scene(301059, contacts=True)
+    found, _ = check_scene(d, seed=301059)
+    assert not [f for f in found if f.kind == "unsafe"], found
+    s = Scene.from_dict({k: v for k, v in d.items() if k != "features"})
+    q = (float(s.goal[0, 0]), float(s.goal[0, 1]), 0.0)
+    tgt = s.target_at(*q)
+    region = complete_region(s, target_at=q)
+    assert not region.contains(shapely.Point(1.35977557, 7.92523474))  # the member of before
+    o = VisOracle(s)
+    seen = shapely.difference(tgt, s.obstacle_union)  # less the 1.4e-9 sliver of the contact
+    for p in _sample(region, 40, np.random.default_rng(0), 1e-6 * s.diameter):
+        assert shapely.difference(seen, o.visibility(p)).area <= 1e-9 * tgt.area, p
