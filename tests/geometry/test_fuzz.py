@@ -544,6 +544,22 @@ def test_certified_bounds_skip_a_target_too_thin_for_cells():
     assert not b.outer.is_empty and b.hausdorff >= 0
 
 
+def _clean_seed(seed: int):
+    """For a fixed contact-fuzz seed: CGAL's ``VisOracle`` class (skips without pyvispoly),
+    the scene dictionary, the Scene and the configuration at G (theta 0), after asserting
+    that the fuzz check finds no ``unsafe`` member on the scene."""
+    pytest.importorskip("pyvispoly")
+    try:
+        from tests.oracle import VisOracle
+    except ImportError:
+        from oracle import VisOracle  # type: ignore[no-redef]
+    d = fuzz_scene(seed, contacts=True)
+    found, _ = check_scene(d, seed=seed)
+    assert not [f for f in found if f.kind == "unsafe"], found
+    s = Scene.from_dict({k: v for k, v in d.items() if k != "features"})
+    return VisOracle, d, s, (float(s.goal[0, 0]), float(s.goal[0, 1]), 0.0)
+
+
 def test_fuzz_seed_300584_member_sees_through_a_pinhole():
     """Fuzz seed 300584 (``benchmarks.fuzz_certify``) reported a member of the stationary
     partial region (theta 0 at G) from which 20,000 samples per outline edge see nothing.
@@ -551,17 +567,7 @@ def test_fuzz_seed_300584_member_sees_through_a_pinhole():
     two slivers (nine times the scene's tolerance).  The checker now also looks along
     the sight lines through such gaps, so the scene is clean, and a member that sees
     through no gap at all is still caught (the gap closed: no longer a member)."""
-    pytest.importorskip("pyvispoly")
-    try:
-        from tests.oracle import VisOracle
-    except ImportError:
-        from oracle import VisOracle  # type: ignore[no-redef]
-
-    d = fuzz_scene(300584, contacts=True)
-    found, _ = check_scene(d, seed=300584)
-    assert not [f for f in found if f.kind == "unsafe"], found
-    s = Scene.from_dict({k: v for k, v in d.items() if k != "features"})
-    q0 = (float(s.goal[0, 0]), float(s.goal[0, 1]), 0.0)
+    VisOracle, d, s, q0 = _clean_seed(300584)
     p = (12.741794116207283, 7.648096356328777)
     assert partial_region(s, target_at=q0).contains(shapely.Point(p))
     tgt = s.target_at(*q0)
@@ -588,21 +594,12 @@ def test_fuzz_seed_301059_flush_obstacle_keeps_its_wedge():
     missed a sliver of the target: CGAL's visibility polygon from one, 0.5 units inside,
     left 5.8e-3 of the target's 0.50 uncovered.  Now every sampled member sees the whole
     target by CGAL, and the fuzz check is clean."""
-    pytest.importorskip("pyvispoly")
-    try:
-        from tests.oracle import VisOracle
-    except ImportError:
-        from oracle import VisOracle  # type: ignore[no-redef]
     import numpy as np
 
     from geometry import complete_region
     from geometry.fuzz import _sample
 
-    d = fuzz_scene(301059, contacts=True)
-    found, _ = check_scene(d, seed=301059)
-    assert not [f for f in found if f.kind == "unsafe"], found
-    s = Scene.from_dict({k: v for k, v in d.items() if k != "features"})
-    q = (float(s.goal[0, 0]), float(s.goal[0, 1]), 0.0)
+    VisOracle, _, s, q = _clean_seed(301059)
     tgt = s.target_at(*q)
     region = complete_region(s, target_at=q)
     assert not region.contains(shapely.Point(1.35977557, 7.92523474))  # the member of before
