@@ -117,6 +117,8 @@ NARROW_FOV_DEG = {
     "edr": 60.0,
     "lab": 75.0,
     "corridor": 90.0,
+    "real/heidelberg_l1": 60.0,
+    "real/heidelberg_l2": 60.0,
     "real/lse_arena": 60.0,
     "real/willow_north": 60.0,
     "real/willow_south": 60.0,

@@ -30,16 +30,23 @@ __all__ = [
 SCENE_DIR = Path(__file__).resolve().parent.parent / "scenes"
 #: the hand-made bundled scenes
 BUNDLED_SCENES = tuple(sorted(p.stem for p in SCENE_DIR.glob("*.json")))
-#: the bundled real floor plans (public ROS maps, ``scenes/real/provenance.json``), by the
-#: names ``real/<stem>``
+#: the bundled real floor plans, by the names ``real/<stem>``: public ROS maps (scene JSON,
+#: ``scenes/real/provenance.json``) and public OpenStreetMap floor plans (GeoJSON,
+#: ``scenes/real/provenance_geojson.json``)
 REAL_SCENES = tuple(
-    f"real/{p.stem}" for p in sorted((SCENE_DIR / "real").glob("*.json")) if p.stem != "provenance"
+    sorted(
+        f"real/{p.stem}"
+        for p in (SCENE_DIR / "real").glob("*")
+        if p.suffix in (".json", ".geojson") and not p.stem.startswith("provenance")
+    )
 )
 
 
 def bundled_scene_path(name: str) -> Path:
-    """Path of the bundled scene JSON ``name`` (e.g. ``"lab"`` or ``"real/willow_north"``)."""
-    return SCENE_DIR / f"{name}.json"
+    """Path of the bundled scene file ``name`` (e.g. ``"lab"`` or ``"real/willow_north"``):
+    scene JSON, or GeoJSON (``.geojson``) for the floor plans imported from OpenStreetMap."""
+    geo = SCENE_DIR / f"{name}.geojson"
+    return geo if geo.exists() else SCENE_DIR / f"{name}.json"
 
 
 def load_scene(spec: str | PathLike[str] | Scene | Mapping, *, name: str | None = None) -> Scene:
@@ -47,6 +54,7 @@ def load_scene(spec: str | PathLike[str] | Scene | Mapping, *, name: str | None 
 
     * a bundled scene name (:data:`BUNDLED_SCENES`: ``lab``, ``edr``, ``corridor``,
       ``warehouse``; :data:`REAL_SCENES`: ``real/willow_north``, ``real/willow_south``,
+      ``real/heidelberg_l1``, ``real/heidelberg_l2``,
       ``real/lse_arena``);
     * a path to a scene file: ``.json`` (scene JSON, or GeoJSON when the object has a
       ``"type"`` member), ``.geojson`` or ``.wkt`` (see :mod:`geometry.formats`);
@@ -66,7 +74,7 @@ def load_scene(spec: str | PathLike[str] | Scene | Mapping, *, name: str | None 
     else:
         s = str(spec)
         if s in BUNDLED_SCENES or s in REAL_SCENES:
-            scene = Scene.load(bundled_scene_path(s))
+            scene = load_scene_file(bundled_scene_path(s))
         else:
             p = Path(s)
             suffixes = SCENE_SUFFIXES + ROS_MAP_SUFFIXES

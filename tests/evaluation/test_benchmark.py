@@ -172,7 +172,8 @@ def test_narrow_splits_replace_the_scenes_field_of_view(tmp_path):
 
     sp = splits(["narrow"], None, needs_start=True)
     assert set(sp) == {"narrow:lab", "narrow:edr", "narrow:corridor", "narrow:lse_arena",
-                       "narrow:willow_north", "narrow:willow_south"}  # fmt: skip
+                       "narrow:willow_north", "narrow:willow_south", "narrow:heidelberg_l1",
+                       "narrow:heidelberg_l2"}  # fmt: skip
     assert sp["narrow:willow_north"]["scene"] == "real/willow_north"
     assert sp["narrow:lab"]["fov_deg"] == 75.0 and sp["narrow:edr"]["fov_deg"] == 60.0
     with pytest.raises(ValueError, match="narrow:<scene or map>"):

@@ -343,7 +343,7 @@ def _edges(s: Scene) -> int:
 
 
 def test_real_scene_files_and_provenance():
-    names = {p.stem for p in REAL.glob("*.json")} - {"provenance"}
+    names = {p.stem for p in REAL.glob("*.json")} - {"provenance", "provenance_geojson"}
     assert names == set(REAL_SCENES)
     prov = json.loads((REAL / "provenance.json").read_text())
     assert set(prov) == set(REAL_SCENES)
