@@ -19,25 +19,22 @@ from __future__ import annotations
 
 import argparse
 import time
-from pathlib import Path
 from typing import Any
 
 from geometry import Scene, swept_bounds
+from sensorplan_gym.core.scenes import BUNDLED_SCENES, REAL_SCENES, load_scene
 
 from . import _results
 
-SCENES = Path(__file__).resolve().parent.parent / "sensorplan_gym" / "scenes"
 
-
-def _paths() -> list[Path]:
-    """The bundled scenes with a polygonal goal region, then the real maps."""
+def _scenes() -> list[tuple[str, Scene]]:
+    """The bundled scenes with a polygonal goal or failure region, then the real maps, by
+    name (``lab``, ``real/willow_north``, ...)."""
     out = []
-    for p in sorted(SCENES.glob("*.json")) + sorted((SCENES / "real").glob("*.json")):
-        if p.name == "provenance.json":
-            continue
-        s = Scene.load(p)
+    for name in (*BUNDLED_SCENES, *REAL_SCENES):
+        s = load_scene(name)
         if s.goal_geom.geom_type == "Polygon" or s.failure_geom.geom_type == "Polygon":
-            out.append(p)
+            out.append((name, s))
     return out
 
 
@@ -69,9 +66,7 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     t0 = time.perf_counter()
     rows = []
-    for path in _paths():
-        rel = path.relative_to(SCENES).with_suffix("").as_posix()
-        s = Scene.load(path)
+    for rel, s in _scenes():
         if s.goal_geom.geom_type == "Polygon":
             rows.append(_row(rel, "swept", s, {"target_in": "goal", "densify": args.densify}))
         rows.append(_row(rel, "5.2", s, {"recognizable": True, "densify": args.densify}))

@@ -1,11 +1,13 @@
-"""The region queries on the bundled real maps (public ROS floor plans), with an anchor.
+"""The region queries on the bundled real maps (public ROS and OpenStreetMap floor plans),
+with an anchor.
 
     python -m benchmarks.real_maps              # about a minute
     python -m benchmarks.real_maps --reps 7
 
 For every scene of ``sensorplan_gym/scenes/real/`` (written by
-:mod:`benchmarks.make_real_maps` from the Willow Garage and LSE arena occupancy maps; G and
-H are regular pentagons) it times, each call on a freshly loaded Scene (so every call
+:mod:`benchmarks.make_real_maps` from the Willow Garage and LSE arena occupancy maps, and by
+:mod:`benchmarks.make_geojson_maps` from an OpenStreetMap indoor map in GeoJSON; G and H are
+regular pentagons) it times, each call on a freshly loaded Scene (so every call
 builds its per-scene structures), median over ``--reps`` calls after one warm-up call:
 
 * ``complete_region`` and ``partial_region`` of the stationary target at G's
@@ -26,19 +28,16 @@ median per point (see :mod:`benchmarks.scaling`).  Data (``real_maps.json``) and
 from __future__ import annotations
 
 import argparse
-import json
 import statistics
 import time
 from collections.abc import Callable
-from pathlib import Path
 from typing import Any
 
 from geometry import Scene, complete_region, partial_region, recognizable_region
+from sensorplan_gym.core.scenes import REAL_SCENES, load_scene, real_scene_provenance
 
 from . import _results
 from .scaling import _anchor
-
-REAL = Path(__file__).resolve().parent.parent / "sensorplan_gym" / "scenes" / "real"
 
 
 def _pose(s: Scene) -> tuple[float, float, float]:
@@ -55,13 +54,13 @@ QUERIES: list[tuple[str, Callable[[Scene], Any]]] = [
 ]
 
 
-def _time_fresh(fn: Callable[[Scene], Any], path: Path, reps: int) -> tuple[float, float]:
+def _time_fresh(fn: Callable[[Scene], Any], name: str, reps: int) -> tuple[float, float]:
     """Median seconds of ``fn`` on a freshly loaded scene (``reps`` calls after a warm-up)
     and the area of its answer."""
-    area = fn(Scene.load(path)).area
+    area = fn(load_scene(name)).area
     times = []
     for _ in range(reps):
-        s = Scene.load(path)
+        s = load_scene(name)
         t0 = time.perf_counter()
         fn(s)
         times.append(time.perf_counter() - t0)
@@ -70,11 +69,11 @@ def _time_fresh(fn: Callable[[Scene], Any], path: Path, reps: int) -> tuple[floa
 
 def run(reps: int) -> dict[str, Any]:
     """Time every query on every real scene; seconds and square metres."""
-    prov = json.loads((REAL / "provenance.json").read_text(encoding="utf-8"))
+    prov = real_scene_provenance()
     rows = []
-    for name in prov:
-        path = REAL / f"{name}.json"
-        s = Scene.load(path)
+    for real in REAL_SCENES:
+        name = real.removeprefix("real/")
+        s = load_scene(real)
         edges = len(s.bounds) + sum(len(o) for o in s.obstacles)
         row: dict[str, Any] = {
             "scene": name,
@@ -85,7 +84,7 @@ def run(reps: int) -> dict[str, Any]:
             "area_m2": {},
         }
         for qname, fn in QUERIES:
-            t, a = _time_fresh(fn, path, reps)
+            t, a = _time_fresh(fn, real, reps)
             row["query_s"][qname] = t
             row["area_m2"][qname] = a
             print(f"  {name:>14} edges={edges:4d} {qname:24s} {1e3 * t:9.1f} ms  {a:8.2f} m2")

@@ -6,7 +6,8 @@
 For scenes from :func:`geometry.generate.scene_with_edges` (``seed=1``) with 100, 200,
 400, 800, 1,600, 3,200 and 8,000 environment edges, and for the bundled large office
 floor (``sensorplan_gym/scenes/large/office_floor.json``) and the real maps of 100-300
-edges (``sensorplan_gym/scenes/real/willow_*.json``, public ROS floor plans), it times with
+edges (``sensorplan_gym/scenes/real/``: two public ROS maps, two OpenStreetMap floor plans
+imported from GeoJSON), it times with
 ``time.perf_counter`` (median over ``--reps`` warm calls on one Scene, the per-scene
 structures already built):
 
@@ -43,6 +44,7 @@ import shapely
 
 from geometry import Scene, complete_region, partial_region, recognizable_region
 from geometry.generate import scene_with_edges
+from sensorplan_gym.core.scenes import load_scene
 
 from . import _results
 
@@ -57,8 +59,9 @@ OFFICE = (
 )
 
 
-#: the bundled real floor plans of 100-300 edges (benchmarks.make_real_maps)
-REAL = sorted(OFFICE.parent.parent.joinpath("real").glob("willow_*.json"))
+#: the bundled real floor plans of 100-300 edges (benchmarks.make_real_maps: public ROS maps;
+#: benchmarks.make_geojson_maps: OpenStreetMap indoor GeoJSON)
+REAL = ("real/heidelberg_l1", "real/heidelberg_l2", "real/willow_north", "real/willow_south")
 
 
 def _pose(s: Scene) -> tuple[float, float, float]:
@@ -175,8 +178,8 @@ def run(
     if office and OFFICE.exists():
         s = Scene.load(OFFICE)
         cases.append(("office floor", len(s.bounds) + sum(len(o) for o in s.obstacles), s))
-    for path in REAL if real else ():
-        s = Scene.load(path)
+    for name in REAL if real else ():
+        s = load_scene(name)
         cases.append((s.name, len(s.bounds) + sum(len(o) for o in s.obstacles), s))
     for label, n, s in cases:
         anchor = _anchor(s)

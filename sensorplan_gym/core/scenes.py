@@ -10,6 +10,7 @@ FeatureCollection) or a :class:`geometry.Scene`.  The envs' ``scene=``, ``sensor
 
 from __future__ import annotations
 
+import json
 from collections.abc import Mapping
 from os import PathLike
 from pathlib import Path
@@ -25,6 +26,7 @@ __all__ = [
     "SCENE_SUFFIXES",
     "bundled_scene_path",
     "load_scene",
+    "real_scene_provenance",
 ]
 
 SCENE_DIR = Path(__file__).resolve().parent.parent / "scenes"
@@ -47,6 +49,17 @@ def bundled_scene_path(name: str) -> Path:
     scene JSON, or GeoJSON (``.geojson``) for the floor plans imported from OpenStreetMap."""
     geo = SCENE_DIR / f"{name}.geojson"
     return geo if geo.exists() else SCENE_DIR / f"{name}.json"
+
+
+def real_scene_provenance() -> dict[str, dict]:
+    """Where each bundled real floor plan comes from, by stem (``"willow_north"``, ...):
+    repository, path, commit, licence, SHA-256 of the source, conversion parameters and the
+    edge count (``scenes/real/provenance*.json``, written by ``benchmarks.make_real_maps``
+    and ``benchmarks.make_geojson_maps``)."""
+    out: dict[str, dict] = {}
+    for p in sorted((SCENE_DIR / "real").glob("provenance*.json")):
+        out.update(json.loads(p.read_text(encoding="utf-8")))
+    return out
 
 
 def load_scene(spec: str | PathLike[str] | Scene | Mapping, *, name: str | None = None) -> Scene:

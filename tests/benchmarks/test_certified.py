@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 from benchmarks import certified
-from geometry import Scene
+from sensorplan_gym.core.scenes import load_scene
 
 
 def test_a_row_brackets_and_renders():
-    s = Scene.load(certified.SCENES / "lab.json")
+    s = load_scene("lab")
     row = certified._row("lab", "swept", s, {"target_in": "goal"})
     assert row["proven"] is not None
     assert row["proven"] <= row["outer"] + 1e-12 and row["inner"] <= row["outer"] + 1e-12
@@ -24,5 +24,6 @@ def test_a_row_brackets_and_renders():
 
 
 def test_only_scenes_with_a_polygonal_region():
-    names = [p.stem for p in certified._paths()]
-    assert "lab" in names and "willow_north" in names and "corridor" not in names
+    names = [n for n, _ in certified._scenes()]
+    assert "lab" in names and "real/willow_north" in names and "corridor" not in names
+    assert "real/heidelberg_l1" in names  # the GeoJSON floor plans too
