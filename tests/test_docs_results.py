@@ -103,3 +103,26 @@ def test_reference_report_with_nothing_to_do_says_so(tmp_path, monkeypatch, caps
     assert (ROOT / "docs" / "results" / "reference.md").read_text(encoding="utf-8") == (
         _results.render("reference", _results.load("reference"))
     )
+
+
+def test_readme_results_block_is_rendered_from_tracked_data(tmp_path):
+    """README.md's results table is what ``benchmarks.readme_results`` renders from the
+    tracked data of navigate_hint, recognize_hint and pixel_placement, and it can fail."""
+    from benchmarks import readme_results
+
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    assert readme_results.block() in readme, (
+        "README.md's results block differs from the tracked data: run "
+        "`python -m benchmarks.readme_results`"
+    )
+    assert readme_results.main(["--check"]) == 0
+    edited = tmp_path / "README.md"
+    edited.write_text(
+        readme.replace("| oracle (exact planner) | – | 1.00 |", "| oracle | – | 0.99 |")
+    )
+    assert readme_results.main(["--check", "--readme", str(edited)]) == 1
+    nav = _results.load("navigate_hint")
+    text = readme_results.render(nav, _results.load("recognize_hint"))
+    # every Navigate policy of the benchmark has its row, imitation beside PPO from scratch
+    for name in nav["policies"]:
+        assert f"| {readme_results.LABELS.get(name, name)} |" in text
