@@ -104,8 +104,11 @@ class ModelPolicy:
     (single) env, normalizes it with the frozen training statistics (``normalize``: SB3's
     ``VecNormalize.normalize_obs``), stacks the last ``frame_stack`` of them (SB3's
     ``StackedObservations``, as ``VecFrameStack`` did in training: oldest first, zeros
-    before the episode's first frame), and asks the model.  ``episode_start`` true (or a
-    ``None`` state on the first call) starts a new stack.  Recurrent models get their LSTM
+    before the episode's first frame), and asks the model.  ``episode_start`` true starts a
+    new stack.  Without ``episode_start`` (a plain ``predict(obs)`` loop) the policy tells a
+    new episode by itself from ``env`` (the env it plays, as :func:`load_policy` binds it:
+    each sensorplan env counts the episodes it started); a stacking policy bound to no such
+    env raises ``ValueError`` there rather than guess.  Recurrent models get their LSTM
     state passed through.
     """
 
@@ -116,9 +119,13 @@ class ModelPolicy:
         *,
         frame_stack: int = 1,
         vecnormalize=None,
+        env=None,
     ) -> None:
-        """``observation_space``: the env's own (one frame, unnormalized)."""
+        """``observation_space``: the env's own (one frame, unnormalized); ``env``: the
+        single env it plays (optional; lets ``predict`` notice new episodes by itself)."""
         self.model = model
+        self._batch = getattr(getattr(env, "unwrapped", None), "batch", None)
+        self._episode = -1
         self.frame_stack = int(frame_stack)
         self.vecnormalize = vecnormalize
         self.observation_space = observation_space
@@ -138,7 +145,18 @@ class ModelPolicy:
             o = self.vecnormalize.normalize_obs(o)
         if self._stack is None:
             return o[0]
-        new = episode_start is None or bool(np.asarray(episode_start).reshape(-1)[0])
+        if episode_start is not None:
+            new = bool(np.asarray(episode_start).reshape(-1)[0])
+        elif self._batch is not None:
+            new = int(self._batch.episodes[0]) != self._episode
+        else:
+            raise ValueError(
+                f"this policy stacks {self.frame_stack} frames: pass episode_start to predict "
+                "(True on an episode's first observation), or load it with its env "
+                "(load_policy(path, env)) so that it notices new episodes itself"
+            )
+        if self._batch is not None:
+            self._episode = int(self._batch.episodes[0])
         if new or not self._started:
             self._started = True
             return self._stack.reset(o)[0]
@@ -394,7 +412,7 @@ def load_policy(spec: str, env, *, seed: int = 0, device: str = "cpu"):
         vecnorm.training = False
     if frame_stack > 1 or vecnorm is not None:
         model = ModelPolicy(
-            model, env.observation_space, frame_stack=frame_stack, vecnormalize=vecnorm
+            model, env.observation_space, frame_stack=frame_stack, vecnormalize=vecnorm, env=env
         )
     if cfg.get("residual"):  # a correction of a fixed controller (agents.learning.residual)
         from .residual import RESIDUAL_SCALE, ResidualPolicy

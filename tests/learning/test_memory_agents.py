@@ -110,6 +110,39 @@ def test_loaded_policy_acts_as_behind_the_training_wrappers(stacked_run):
     assert steps > 4  # more than one stacked frame was compared
 
 
+def test_plain_predict_loop_notices_new_episodes(stacked_run):
+    """``policy.predict(obs)`` in a plain loop, as a user writes it (no ``episode_start``),
+    plays exactly as with ``episode_start``: the policy bound to its env starts a new frame
+    stack at each reset, and keeps stacking within an episode.  Unbound, it refuses."""
+    kw = {**REC_KW, "random_start": True}
+    actions = []
+    for plain in (False, True):
+        env = gym.make(REC, **kw)
+        policy = load_policy(stacked_run["best_model"], env)
+        acts = []
+        for seed in (21, 22, 23):
+            obs, _ = env.reset(seed=seed)
+            start, done = True, False
+            while not done:
+                if plain:
+                    a, _ = policy.predict(obs, deterministic=True)
+                else:
+                    a, _ = policy.predict(obs, episode_start=np.array([start]), deterministic=True)
+                acts.append(np.asarray(a).copy())
+                obs, _, term, trunc, _ = env.step(a)
+                done, start = term or trunc, False
+        actions.append(np.stack(acts))
+    np.testing.assert_array_equal(actions[0], actions[1])
+    assert len(actions[0]) > 6
+    env = gym.make(REC, **kw)
+    bound = load_policy(stacked_run["best_model"], env)
+    unbound = ModelPolicy(bound.model, env.observation_space, frame_stack=3)
+    obs, _ = env.reset(seed=0)
+    with pytest.raises(ValueError, match="pass episode_start"):
+        unbound.predict(obs)
+    unbound.predict(obs, episode_start=np.array([True]))  # given: fine
+
+
 def test_missing_normalization_statistics_fail_clearly(stacked_run, tmp_path):
     out = Path(stacked_run["out"])
     for suffix in (".zip", ".yaml"):
