@@ -21,10 +21,11 @@ bundled level, deterministically:
   building's 60 m the scale error is below 1e-5);
 * the free space is the union of the level's rooms, corridors, halls and stair wells,
   each shrunk by half a wall (``wall`` / 2, mitred corners), and of one opening per door
-  (a square of the door's tagged width, default 0.9 m, centred on the door node, where
-  the node lies within 5 cm of an outline of that level, shared edges included, clipped
-  to the outlines grown by ``wall``): OSM draws rooms edge to edge or with a gap, and the
-  walls are what separates them;
+  (a square of the door's tagged width, default 0.9 m, centred on the door node, for every
+  door node that is a vertex of an outline of that level -- door nodes carry no level, and
+  other levels' doors stand on the same wall lines -- clipped to the outlines grown by
+  ``wall``): OSM draws rooms edge to edge or with a gap, and the walls are what separates
+  them;
 * the largest connected part is kept and simplified (``simplify`` metres, topology
   preserved); it is written as the ``bounds`` Polygon of the scene's GeoJSON, whose holes
   (wall pieces standing free between doors) :func:`geometry.formats.scene_from_geojson`
@@ -85,7 +86,7 @@ SOURCE = {
 SCENES: dict[str, dict[str, Any]] = {
     "heidelberg_l1": {
         "level": "1",
-        "what": "level 1 ('1. Obergeschoss'): L-shaped floor, two corridors, 28 rooms and a hall",
+        "what": "level 1 ('1. Obergeschoss'): L-shaped floor, two corridors and its rooms",
         "wall": 0.15,
         "simplify": 0.05,
         "size": 0.3,
@@ -93,7 +94,7 @@ SCENES: dict[str, dict[str, Any]] = {
     },
     "heidelberg_l2": {
         "level": "2",
-        "what": "level 2 ('Dachgeschoss'): one wing, a corridor, 16 rooms and a hall",
+        "what": "level 2 ('Dachgeschoss'): one wing, a corridor, its rooms and a hall",
         "wall": 0.15,
         "simplify": 0.05,
         "size": 0.3,
@@ -156,17 +157,25 @@ def level_free_space(
         )
 
     feats = collection["features"]
-    parts = [
-        proj(shape(f["geometry"]))
+    mine = [
+        f
         for f in feats
         if f["geometry"]["type"] == "Polygon"
         and (f["properties"].get("tags") or {}).get("buildingpart") in WALKABLE
         and level in _levels(f)
     ]
-    if not parts:
+    if not mine:
         raise ValueError(f"level {level!r}: no walkable buildingpart polygons")
+    parts = [proj(shape(f["geometry"])) for f in mine]
+    # a door node belongs to the ways it is a vertex of: the level's doors are the door nodes
+    # at a vertex of its outlines (nodes carry no level; other levels' doors stand on the
+    # same wall lines)
+    corners = {
+        (round(x, 9), round(y, 9))
+        for f in mine
+        for x, y in shapely.get_coordinates(shape(f["geometry"]))
+    }
     outline = shapely.union_all(parts)
-    walls = shapely.union_all(shapely.boundary(parts))  # every outline, shared edges too
     floor = shapely.union_all([p.buffer(-wall / 2, join_style="mitre") for p in parts])
     grown = outline.buffer(wall)
     doors = []
@@ -174,8 +183,9 @@ def level_free_space(
         tags = f["properties"].get("tags") or {}
         if f["geometry"]["type"] != "Point" or tags.get("door") in (None, "no"):
             continue
-        p = proj(shape(f["geometry"]))
-        if walls.distance(p) < 0.05:
+        x, y = f["geometry"]["coordinates"][:2]
+        if (round(x, 9), round(y, 9)) in corners:
+            p = proj(shape(f["geometry"]))
             doors.append(p.buffer(_width(tags) / 2, cap_style="square").intersection(grown))
     free = shapely.union_all([floor, *doors])
     comps = sorted(shapely.get_parts(free), key=lambda g: -g.area)

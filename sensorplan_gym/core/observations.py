@@ -277,8 +277,9 @@ def view_hint(worlds: list[World], x, y, psi) -> np.ndarray:
     """``(k, 3)`` float64: the ``view_hint`` of poses ``(x, y, psi)`` (world frame, radians)
     in ``worlds`` (one per pose): the way to the nearest pixel that sees every corner of K_G
     and K_H with a passing aim, along the shortest grid path in the robot's free space
-    (:meth:`World.hint_field`): the unit vector toward the path's waypoint a few pixels ahead,
-    in the robot's frame (zero on it, and where no such pixel is reachable), then the length
+    (:meth:`World.hint_field`, followed from the pixel of :meth:`World.hint_cells`): the unit
+    vector toward the farthest of the path's waypoints a few pixels ahead that is in plain
+    sight, in the robot's frame (zero on it, and where no such pixel is reachable), then the length
     of the way there, straight to the waypoint and on along the path, / diameter clipped to
     ``[0, 1]`` (0 at a target pixel's centre, 1 where none is reachable)."""
     k = len(x)
@@ -290,15 +291,21 @@ def view_hint(worlds: list[World], x, y, psi) -> np.ndarray:
     rest = np.empty(k)  # the path's length on from each waypoint (no waypoint: inf)
     space = np.empty(k, dtype=object)
     size = np.empty(k)
+    centre = np.empty((k, 2))  # the centre of the pixel whose path the pose follows
     for rows in groups.values():
         w = worlds[rows[0]]
         field, dist = w.hint_field()
-        i, j = w.to_cell(dist.shape[0], x[rows], y[rows])
+        i, j = w.hint_cells(x[rows], y[rows], dist.shape[0])
         ways[:, rows] = field[:, i, j]
+        X, Y = w.pixel_centres(dist.shape[0])
+        centre[rows] = np.column_stack([X[i, j], Y[i, j]])
         space[rows] = w.robot_space
         size[rows] = w.diameter
     xy = np.column_stack([x, y])
-    way = ways[-1]  # the nearest waypoint, unless a farther one is in plain sight
+    # the farthest waypoint in plain sight; the nearest, or failing that the pixel's own
+    # centre (in sight, unless no pixel nearby is), when none is
+    near = shapely.covers(space, shapely.linestrings(np.stack([xy, ways[-1]], axis=1)))
+    way = np.where(near[:, None], ways[-1], centre)
     for far in ways[-2::-1]:
         free = shapely.covers(space, shapely.linestrings(np.stack([xy, far], axis=1)))
         way = np.where(free[:, None], far, way)

@@ -481,7 +481,16 @@ class World:
             flat = np.arange(size * size).reshape(size, size)
             free = np.flatnonzero(space)
             cost = 1.0 + 4.0 * np.clip(1.0 - ndimage.distance_transform_edt(space) / 3.0, 0, 1)
+            # a step joins two pixels only where its segment stays in the robot's space: a
+            # wall thinner than a pixel holds no pixel centre, and must still block the path
+            pix = 1.0 / self.grid_transform(size)[0]
+            shapely.prepare(self.robot_space)
+            clear = np.full(size * size, np.inf)
+            clear[free] = shapely.distance(
+                self.robot_space.boundary, shapely.points(X.ravel()[free], Y.ravel()[free])
+            )
             rows, cols, w = [], [], []
+            step = {}  # (di, dj) -> where a pixel may step to its neighbour at that offset
             for di, dj in ((0, 1), (1, 0), (1, 1), (1, -1)):
                 a = flat[: size - di, max(0, -dj) : size - max(0, dj)]
                 b = flat[di:, max(0, dj) : size + min(0, dj)]
@@ -489,6 +498,24 @@ class World:
                     space[: size - di, max(0, -dj) : size - max(0, dj)]
                     & space[di:, max(0, dj) : size + min(0, dj)]
                 )
+                near = ok & (clear[a] < math.hypot(di, dj) * pix)  # else the step is clear
+                if near.any():
+                    ia, ib = a[near], b[near]
+                    seg = shapely.linestrings(
+                        np.stack(
+                            [
+                                np.column_stack([X.ravel()[ia], Y.ravel()[ia]]),
+                                np.column_stack([X.ravel()[ib], Y.ravel()[ib]]),
+                            ],
+                            axis=1,
+                        )
+                    )
+                    ok[near] = shapely.covers(self.robot_space, seg)
+                fwd = np.zeros((size, size), dtype=bool)
+                fwd[: size - di, max(0, -dj) : size - max(0, dj)] = ok
+                back = np.zeros((size, size), dtype=bool)
+                back[di:, max(0, dj) : size + min(0, dj)] = ok
+                step[(di, dj)], step[(-di, -dj)] = fwd, back
                 rows.append(a[ok])
                 cols.append(b[ok])
                 ca = cost[: size - di, max(0, -dj) : size - max(0, dj)][ok]
@@ -510,7 +537,7 @@ class World:
                     if di == dj == 0:
                         continue
                     nb = pad[1 + di : 1 + di + size, 1 + dj : 1 + dj + size]
-                    better = nb < best
+                    better = (nb < best) & step[(di, dj)]  # along the graph's edges only
                     best = np.where(better, nb, best)
                     succ = np.where(better, np.roll(np.roll(flat, -di, 0), -dj, 1), succ)
             nxt = succ.ravel()
@@ -562,6 +589,47 @@ class World:
         ox = float(self.lo[0]) - 0.5 * (span - float(self.hi[0] - self.lo[0]))
         oy = float(self.lo[1]) - 0.5 * (span - float(self.hi[1] - self.lo[1]))
         return scale, ox, oy
+
+    def hint_cells(self, x, y, size: int = HINT_SIZE) -> tuple[np.ndarray, np.ndarray]:
+        """The pixels ``(i, j)`` of :meth:`hint_field`'s grid whose paths poses ``(x, y)``
+        (world frame) follow: the pixel holding the point when the segment from the point to
+        its centre lies in the robot's space (so no wall between them), else the pixel of the
+        5 x 5 around it in the space whose centre the point sees and whose way on (the
+        segment plus its path) is shortest; the holding pixel where there is none.  A wall
+        thinner than a pixel holds no pixel centre, so the holding pixel, or the nearest one
+        inside the space whose values it takes, can lie behind it."""
+        x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+        i, j = self.to_cell(size, x, y)
+        dist = self.hint_field(size)[1]
+        X, Y = self.pixel_centres(size)
+        inside = self._cache.get(f"hintspace{size}")
+        if inside is None:
+            inside = self._cache[f"hintspace{size}"] = shapely.contains_xy(self.robot_space, X, Y)
+        shapely.prepare(self.robot_space)
+        own = shapely.linestrings(
+            np.stack([np.column_stack([x, y]), np.column_stack([X[i, j], Y[i, j]])], axis=1)
+        )
+        bad = ~(inside[i, j] & shapely.covers(self.robot_space, own))
+        if bad.any():
+            k = np.flatnonzero(bad)
+            off = np.arange(-2, 3)
+            di, dj = (a.ravel() for a in np.meshgrid(off, off, indexing="ij"))
+            ci = np.clip(i[k, None] + di, 0, size - 1)  # (m, 25)
+            cj = np.clip(j[k, None] + dj, 0, size - 1)
+            cx, cy = X[ci, cj], Y[ci, cj]
+            px, py = np.broadcast_to(x[k, None], cx.shape), np.broadcast_to(y[k, None], cx.shape)
+            ok = inside[ci, cj] & np.isfinite(dist[ci, cj])
+            seg = shapely.linestrings(
+                np.stack([np.stack([px, py], -1), np.stack([cx, cy], -1)], axis=-2)[ok]
+            )
+            seen = np.zeros_like(ok)
+            seen[ok] = shapely.covers(self.robot_space, seg)
+            way = np.where(seen, np.hypot(cx - px, cy - py) + dist[ci, cj], np.inf)
+            best = np.argmin(way, axis=1)
+            found = np.isfinite(way[np.arange(len(k)), best])
+            i[k[found]] = ci[found, best[found]]
+            j[k[found]] = cj[found, best[found]]
+        return i, j
 
     def to_cell(self, size: int, x, y):
         scale, ox, oy = self.grid_transform(size)

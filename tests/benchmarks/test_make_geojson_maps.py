@@ -56,8 +56,10 @@ def test_stationary_regions_nonempty(name):
     assert s.free_space.buffer(1e-6 * s.diameter).covers(part)
 
 
-def _room(x0, y0, x1, y1, kind="room", level="1"):
-    ring = [[x0, y0], [x1, y0], [x1, y1], [x0, y1], [x0, y0]]
+def _room(x0, y0, x1, y1, kind="room", level="1", top=(), bottom=()):
+    """A rectangle with extra vertices (door nodes) at x positions ``top`` and ``bottom``."""
+    ring = [[x0, y0], *[[x, y0] for x in bottom], [x1, y0], [x1, y1]]
+    ring += [*[[x, y1] for x in sorted(top, reverse=True)], [x0, y1], [x0, y0]]
     return {
         "type": "Feature",
         "properties": {
@@ -90,15 +92,17 @@ def _collection(feats):
 
 
 def test_level_free_space_walls_doors_and_levels():
-    # two rooms edge to edge on a corridor; a door from room A to the corridor only; a room
-    # on another level overlapping room B; a door node not on any outline of the level
+    # two rooms edge to edge on a corridor; a door node at (2, 4), a vertex of room A and of
+    # the corridor; a door node at (6, 4) that is a vertex of the level-2 room only (door
+    # nodes carry no level; OSM's levels share wall lines); a door node inside room B
     feats = [
-        _room(0, 0, 4, 4),  # A
-        _room(4, 0, 8, 4),  # B (no door: walled off)
-        _room(0, 4, 8, 6, kind="corridor"),
-        _room(0, 0, 8, 4, level="2"),
+        _room(0, 0, 4, 4, top=(2,)),  # A
+        _room(4, 0, 8, 4),  # B (no door of its own level: walled off)
+        _room(0, 4, 8, 6, kind="corridor", bottom=(2,)),
+        _room(4, 0, 8, 4, level="2", top=(6,)),
         _door(2, 4),
-        _door(6, 2, width="oops"),  # inside B, not on an outline: ignored
+        _door(6, 4),
+        _door(6, 2, width="oops"),
     ]
     free, counts = mk.level_free_space(_collection(feats), "1", wall=0.2, simplify=0.0)
     assert counts == {"parts": 3, "doors": 1, "components": 2}
@@ -108,6 +112,7 @@ def test_level_free_space_walls_doors_and_levels():
     assert free.contains(shapely.points(2 - 4, 4 - 3))  # the door
     assert not free.contains(shapely.points(1 - 4, 4 - 3))  # the wall beside it
     assert not free.contains(shapely.points(6 - 4, 2 - 3))  # room B
+    assert not free.contains(shapely.points(6 - 4, 4 - 3))  # the level-2 door is a wall here
     with pytest.raises(ValueError, match="level '7': no walkable"):
         mk.level_free_space(_collection(feats), "7", wall=0.2, simplify=0.0)
 

@@ -125,3 +125,54 @@ def test_shipped_hint_policies_play_with_their_observation(env_id, name):
     )  # fmt: skip
     p = res["policies"][0]
     assert p["play_env_kwargs"]["view_hint"] is True and p["successes"] >= 5
+
+
+def _thin_wall_scene(width: float = 0.02) -> dict:
+    """A 20 x 10 room split by a wall ``width`` thick (a crack in the bounds, far thinner than
+    a hint pixel of 20 / 128) from the floor up to y = 8; G and H on its left."""
+    return {
+        "name": "thin_wall",
+        "bounds": [
+            [0, 0],
+            [10, 0],
+            [10, 8],
+            [10 + width, 8],
+            [10 + width, 0],
+            [20, 0],
+            [20, 10],
+            [0, 10],
+        ],  # fmt: skip
+        "obstacles": [],
+        "target": [[-0.3, -0.2], [0.3, -0.2], [0.3, 0.2], [-0.3, 0.2]],
+        "goal": [[3.0, 3.0]],
+        "failure": [[3.0, 7.0]],
+        "start": [10.3, 2.0, 0.0],
+    }
+
+
+def test_hint_does_not_lead_through_a_wall_thinner_than_a_pixel():
+    """A wall holds no pixel centre when it is thinner than a pixel: the grid path must
+    still go round it (through the opening at the top), the pose beside the wall must follow
+    a pixel on its own side, and the hint rule must get there."""
+    from agents.planning.hint_rule import HintRulePolicy
+
+    env = gym.make("sensorplan/Navigate-v0", scene=_thin_wall_scene(), view_hint=True, **KW)
+    o, _ = env.reset(seed=0)
+    w = env.unwrapped.world
+    assert 20 / HINT_SIZE > 5 * 0.02  # the wall is far thinner than a pixel
+    hx, hy, d = o[-3:]
+    # robot frame = world frame at heading 0: up toward the opening, not left through the wall
+    assert hy > 0.7 and hx > -0.5, (hx, hy)
+    # the way on is at least the way round the wall's end (up 6, across, down to the region)
+    assert d * w.diameter > 6.0
+    # the pixel followed lies on the start's side of the wall
+    i, j = w.hint_cells(np.array([10.3]), np.array([2.0]))
+    X, _ = w.pixel_centres(HINT_SIZE)
+    assert X[i[0], j[0]] > 10.02
+    policy = HintRulePolicy(env)
+    for _ in range(200):
+        a, _ = policy.predict(o)
+        o, _, term, trunc, info = env.step(a)
+        if term or trunc:
+            break
+    assert info["is_success"], info
