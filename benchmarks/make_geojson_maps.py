@@ -48,7 +48,6 @@ import argparse
 import hashlib
 import json
 import math
-import sys
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -57,7 +56,7 @@ import numpy as np
 import shapely
 from shapely.geometry import shape
 
-from benchmarks.make_real_maps import _centre, _in_sight, _pentagon, _r
+from benchmarks.make_real_maps import _centre, _in_sight, _pentagon, _r, write_or_check
 from geometry.formats import scene_from_geojson
 
 OUT = Path(__file__).resolve().parent.parent / "sensorplan_gym" / "scenes" / "real"
@@ -276,19 +275,7 @@ def main(argv: list[str] | None = None) -> None:
             flush=True,
         )
     texts[PROVENANCE] = json.dumps(provenance, indent=1, ensure_ascii=False) + "\n"
-    bad = 0
-    for fname, text in texts.items():
-        p = args.out / fname
-        if args.check:
-            if not p.exists() or p.read_text(encoding="utf-8") != text:
-                print(f"differs: {p}")
-                bad += 1
-        else:
-            p.parent.mkdir(parents=True, exist_ok=True)
-            p.write_text(text, encoding="utf-8")
-            print(f"wrote {p}")
-    if bad:
-        sys.exit(1)
+    write_or_check(texts, args.out, args.check)
 
 
 if __name__ == "__main__":

@@ -260,10 +260,16 @@ def main(argv: list[str] | None = None) -> None:
         texts[f"{name}.json"] = Scene.from_dict(d).to_json()
         print(f"{name}: {prov['edges']} edges, {prov['obstacles']} obstacles", flush=True)
     texts[PROVENANCE] = json.dumps(provenance, indent=1) + "\n"
+    write_or_check(texts, args.out, args.check)
+
+
+def write_or_check(texts: dict[str, str], out: Path, check: bool) -> None:
+    """Write each file name -> text under ``out``; with ``check`` compare instead, print the
+    files that differ and exit with status 1 if any does."""
     bad = 0
     for fname, text in texts.items():
-        p = args.out / fname
-        if args.check:
+        p = out / fname
+        if check:
             if not p.exists() or p.read_text(encoding="utf-8") != text:
                 print(f"differs: {p}")
                 bad += 1
