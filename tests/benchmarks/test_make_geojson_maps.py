@@ -130,3 +130,44 @@ def test_wrong_input_is_refused(tmp_path):
     p.write_text("var geoJSON = {};")
     with pytest.raises(SystemExit, match="SHA-256 .* is not the recorded"):
         mk.main(["--osm", str(p), "--out", str(tmp_path), "--check"])
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_swept_region_agrees_with_cgal(name):
+    """The swept partial region over G on the floor plans, against CGAL's visibility
+    (pyvispoly): placements inside it (away from its boundary) see part of the target at G's
+    vertices, boundary samples and interior samples; placements outside it (and outside the
+    swept target) are blinded by one of 200 configurations on G's boundary and inside G."""
+    pytest.importorskip("pyvispoly")  # the dev extra
+    from tests import oracle as pv
+
+    rng = np.random.default_rng(7)
+    s = load_scene(f"real/{name}")
+    D = s.diameter
+    swept = partial_region(s, target_in="goal", theta=0.0)
+    g = s.goal_geom
+    ring = [g.exterior.interpolate(t, normalized=True) for t in np.linspace(0, 1, 160, False)]
+    x0, y0, x1, y1 = g.bounds
+    c = rng.uniform([x0, y0], [x1, y1], (400, 2))
+    c = c[shapely.contains_xy(g, c[:, 0], c[:, 1])][:35]
+    dense = np.vstack([np.asarray(s.goal), shapely.get_coordinates(ring), c])
+    few = np.vstack([np.asarray(s.goal), shapely.get_coordinates(ring[::16]), c[:5]])
+    orc = pv.VisOracle(s)
+
+    def sees_all(p, qs):
+        vis = orc.visibility(p)
+        return all(pv.sees_partially(orc, p, s.target_at(q[0], q[1], 0.0), vis) for q in qs)
+
+    def sample(region, n):
+        b = region.bounds
+        pts = rng.uniform(b[:2], b[2:], (40 * n, 2))
+        pts = pts[shapely.contains_xy(region, pts[:, 0], pts[:, 1])][:n]
+        assert len(pts) == n
+        return pts
+
+    for p in sample(swept.buffer(-1e-3 * D), 25):
+        assert sees_all(p, few), p
+    hull = shapely.union_all([s.target_at(q[0], q[1], 0.0) for q in dense]).convex_hull
+    out = s.free_space.difference(swept.buffer(1e-3 * D)).difference(hull.buffer(1e-3 * D))
+    for p in sample(out, 25):
+        assert not sees_all(p, dense), p
