@@ -61,7 +61,7 @@ from . import fused
 from .kernels import libm
 from .queries import hull_arcs, joint_arc
 from .sensor import RangeSensor
-from .world import HINT_AHEAD
+from .world import HINT_AHEAD, HINT_SIZE, hint_blocked, pixel_of
 
 if TYPE_CHECKING:  # pragma: no cover
     from .sim import BatchSim
@@ -88,11 +88,7 @@ def grid_cells(sim: BatchSim, idx: np.ndarray, size: int, x, y) -> tuple[np.ndar
     scale = size / span
     ox = lo[:, 0] - 0.5 * (span - (hi[:, 0] - lo[:, 0]))
     oy = lo[:, 1] - 0.5 * (span - (hi[:, 1] - lo[:, 1]))
-    if np.ndim(x) == 2:
-        scale, ox, oy = scale[:, None], ox[:, None], oy[:, None]
-    j = np.clip(((x - ox) * scale).astype(int), 0, size - 1)
-    i = np.clip((size - (y - oy) * scale).astype(int), 0, size - 1)
-    return i, j
+    return pixel_of(np.column_stack([scale, ox, oy]), size, x, y)
 
 
 def _scaled(world: World, x: float, y: float) -> tuple[float, float]:
@@ -292,28 +288,53 @@ def view_hint(worlds: list[World], x, y, psi) -> np.ndarray:
     space = np.empty(k, dtype=object)
     size = np.empty(k)
     centre = np.empty((k, 2))  # the centre of the pixel whose path the pose follows
+    clear = np.empty(k)  # its clearance
+    grid = np.empty((k, 3))  # each pose's world's grid transform (scale, ox, oy)
+    for rows in groups.values():
+        grid[rows] = worlds[rows[0]].grid_transform(HINT_SIZE)
+    ci, cj = pixel_of(grid, HINT_SIZE, x, y)
+    cells = {}
     for rows in groups.values():
         w = worlds[rows[0]]
-        field, dist = w.hint_field()
-        i, j = w.hint_cells(x[rows], y[rows], dist.shape[0])
-        ways[:, rows] = field[:, i, j]
-        X, Y = w.pixel_centres(dist.shape[0])
+        i, j = ci[rows], cj[rows]
+        X, Y = w.pixel_centres(HINT_SIZE)
         centre[rows] = np.column_stack([X[i, j], Y[i, j]])
+        clear[rows] = w.hint_clearance(HINT_SIZE)[i, j]
         space[rows] = w.robot_space
         size[rows] = w.diameter
+        cells[id(w)] = (i, j)
+    # a pose behind a wall from its pixel's centre follows a pixel it sees (World.hint_cells)
+    bad = hint_blocked(x, y, centre[:, 0], centre[:, 1], clear, space)
+    for rows in groups.values():
+        w = worlds[rows[0]]
+        i, j = cells[id(w)]
+        b = bad[rows]
+        if b.any():
+            r = np.asarray(rows)[b]
+            i[b], j[b] = w.hint_search(x[r], y[r], i[b], j[b], HINT_SIZE)
+            X, Y = w.pixel_centres(HINT_SIZE)
+            centre[r] = np.column_stack([X[i[b], j[b]], Y[i[b], j[b]]])
+            clear[r] = w.hint_clearance(HINT_SIZE)[i[b], j[b]]
+        ways[:, rows] = w.hint_field(HINT_SIZE)[0][:, i, j]
     xy = np.column_stack([x, y])
     # the farthest waypoint in plain sight; the nearest, or failing that the pixel's own
-    # centre (in sight, unless no pixel nearby is), when none is
-    near = shapely.covers(space, shapely.linestrings(np.stack([xy, ways[-1]], axis=1)))
+    # centre (in sight, unless no pixel nearby is), when none is.  The segment to the
+    # nearest lies in the disc around the centre that holds both its ends: tested only where
+    # that disc reaches the boundary
+    reach = np.maximum(np.hypot(*(xy - centre).T), np.hypot(*(ways[-1] - centre).T))
+    near = clear > reach
+    test = np.flatnonzero(~near)
+    if len(test):
+        near[test] = shapely.covers(
+            space[test], shapely.linestrings(np.stack([xy[test], ways[-1][test]], axis=1))
+        )
     way = np.where(near[:, None], ways[-1], centre)
     for far in ways[-2::-1]:
         free = shapely.covers(space, shapely.linestrings(np.stack([xy, far], axis=1)))
         way = np.where(free[:, None], far, way)
+    wi, wj = pixel_of(grid, HINT_SIZE, way[:, 0], way[:, 1])
     for rows in groups.values():
-        w = worlds[rows[0]]
-        dist = w.hint_field()[1]
-        wi, wj = w.to_cell(dist.shape[0], way[rows, 0], way[rows, 1])
-        rest[rows] = dist[wi, wj]
+        rest[rows] = worlds[rows[0]].hint_field()[1][wi[rows], wj[rows]]
     dx, dy = way[:, 0] - x, way[:, 1] - y
     n = np.hypot(dx, dy)
     left = rest + n  # to the waypoint, then on along the path

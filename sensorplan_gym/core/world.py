@@ -485,10 +485,7 @@ class World:
             # wall thinner than a pixel holds no pixel centre, and must still block the path
             pix = 1.0 / self.grid_transform(size)[0]
             shapely.prepare(self.robot_space)
-            clear = np.full(size * size, np.inf)
-            clear[free] = shapely.distance(
-                self.robot_space.boundary, shapely.points(X.ravel()[free], Y.ravel()[free])
-            )
+            clear = self.hint_clearance(size).ravel()
             rows, cols, w = [], [], []
             step = {}  # (di, dj) -> where a pixel may step to its neighbour at that offset
             for di, dj in ((0, 1), (1, 0), (1, 1), (1, -1)):
@@ -578,10 +575,17 @@ class World:
 
     def pixel_centres(self, size: int) -> tuple[np.ndarray, np.ndarray]:
         """``(X, Y)`` ``(size, size)``: the world coordinates of the centres of :meth:`raster`'s
-        pixels (row 0 at the top)."""
-        scale, ox, oy = self.grid_transform(size)
-        ij = np.arange(size) + 0.5
-        return tuple(np.meshgrid(ox + ij / scale, oy + (size - ij) / scale))
+        pixels (row 0 at the top); cached, read-only."""
+        key = f"centres{size}"
+        got = self._cache.get(key)
+        if got is None:
+            scale, ox, oy = self.grid_transform(size)
+            ij = np.arange(size) + 0.5
+            got = tuple(np.meshgrid(ox + ij / scale, oy + (size - ij) / scale))
+            for a in got:
+                a.setflags(write=False)
+            self._cache[key] = got
+        return got
 
     def grid_transform(self, size: int) -> tuple[float, float, float]:
         span = float(max(self.hi - self.lo))
@@ -590,52 +594,99 @@ class World:
         oy = float(self.lo[1]) - 0.5 * (span - float(self.hi[1] - self.lo[1]))
         return scale, ox, oy
 
+    def hint_clearance(self, size: int = HINT_SIZE) -> np.ndarray:
+        """``(size, size)``: the exact distance from each pixel centre of :meth:`raster`'s grid
+        to the robot space's boundary (scene units), 0 for centres outside the space (cached)."""
+        key = f"hintclear{size}"
+        got = self._cache.get(key)
+        if got is None:
+            X, Y = self.pixel_centres(size)
+            got = np.zeros((size, size))
+            inside = shapely.contains_xy(self.robot_space, X, Y)
+            got[inside] = shapely.distance(
+                self.robot_space.boundary, shapely.points(X[inside], Y[inside])
+            )
+            got = self._cache[key] = got
+        return got
+
     def hint_cells(self, x, y, size: int = HINT_SIZE) -> tuple[np.ndarray, np.ndarray]:
         """The pixels ``(i, j)`` of :meth:`hint_field`'s grid whose paths poses ``(x, y)``
         (world frame) follow: the pixel holding the point when the segment from the point to
-        its centre lies in the robot's space (so no wall between them), else the pixel of the
-        5 x 5 around it in the space whose centre the point sees and whose way on (the
-        segment plus its path) is shortest; the holding pixel where there is none.  A wall
-        thinner than a pixel holds no pixel centre, so the holding pixel, or the nearest one
-        inside the space whose values it takes, can lie behind it."""
+        its centre lies in the robot's space (so no wall between them), else
+        :meth:`hint_search`'s pixel.  A wall thinner than a pixel holds no pixel centre, so
+        the holding pixel, or the nearest one inside the space whose values it takes, can
+        lie behind it."""
         x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
         i, j = self.to_cell(size, x, y)
+        X, Y = self.pixel_centres(size)
+        clear = self.hint_clearance(size)[i, j]
+        space = np.full(len(x), self.robot_space, dtype=object)
+        bad = hint_blocked(x, y, X[i, j], Y[i, j], clear, space)
+        if bad.any():
+            i[bad], j[bad] = self.hint_search(x[bad], y[bad], i[bad], j[bad], size)
+        return i, j
+
+    def hint_search(self, x, y, i, j, size: int = HINT_SIZE) -> tuple[np.ndarray, np.ndarray]:
+        """For poses ``(x, y)`` held by pixels ``(i, j)`` behind a wall: the pixel of the
+        5 x 5 around each in the robot's space whose centre the pose sees and whose way on
+        (the segment plus its path) is shortest; the holding pixel where there is none."""
+        i, j = np.array(i), np.array(j)
         dist = self.hint_field(size)[1]
         X, Y = self.pixel_centres(size)
-        inside = self._cache.get(f"hintspace{size}")
-        if inside is None:
-            inside = self._cache[f"hintspace{size}"] = shapely.contains_xy(self.robot_space, X, Y)
+        inside = self.hint_clearance(size) > 0.0
         shapely.prepare(self.robot_space)
-        own = shapely.linestrings(
-            np.stack([np.column_stack([x, y]), np.column_stack([X[i, j], Y[i, j]])], axis=1)
+        off = np.arange(-2, 3)
+        di, dj = (a.ravel() for a in np.meshgrid(off, off, indexing="ij"))
+        ci = np.clip(i[:, None] + di, 0, size - 1)  # (m, 25)
+        cj = np.clip(j[:, None] + dj, 0, size - 1)
+        cx, cy = X[ci, cj], Y[ci, cj]
+        px, py = np.broadcast_to(x[:, None], cx.shape), np.broadcast_to(y[:, None], cx.shape)
+        ok = inside[ci, cj] & np.isfinite(dist[ci, cj])
+        seg = shapely.linestrings(
+            np.stack([np.stack([px, py], -1), np.stack([cx, cy], -1)], axis=-2)[ok]
         )
-        bad = ~(inside[i, j] & shapely.covers(self.robot_space, own))
-        if bad.any():
-            k = np.flatnonzero(bad)
-            off = np.arange(-2, 3)
-            di, dj = (a.ravel() for a in np.meshgrid(off, off, indexing="ij"))
-            ci = np.clip(i[k, None] + di, 0, size - 1)  # (m, 25)
-            cj = np.clip(j[k, None] + dj, 0, size - 1)
-            cx, cy = X[ci, cj], Y[ci, cj]
-            px, py = np.broadcast_to(x[k, None], cx.shape), np.broadcast_to(y[k, None], cx.shape)
-            ok = inside[ci, cj] & np.isfinite(dist[ci, cj])
-            seg = shapely.linestrings(
-                np.stack([np.stack([px, py], -1), np.stack([cx, cy], -1)], axis=-2)[ok]
-            )
-            seen = np.zeros_like(ok)
-            seen[ok] = shapely.covers(self.robot_space, seg)
-            way = np.where(seen, np.hypot(cx - px, cy - py) + dist[ci, cj], np.inf)
-            best = np.argmin(way, axis=1)
-            found = np.isfinite(way[np.arange(len(k)), best])
-            i[k[found]] = ci[found, best[found]]
-            j[k[found]] = cj[found, best[found]]
+        seen = np.zeros_like(ok)
+        seen[ok] = shapely.covers(self.robot_space, seg)
+        way = np.where(seen, np.hypot(cx - px, cy - py) + dist[ci, cj], np.inf)
+        best = np.argmin(way, axis=1)
+        found = np.isfinite(way[np.arange(len(i)), best])
+        i[found] = ci[found, best[found]]
+        j[found] = cj[found, best[found]]
         return i, j
 
     def to_cell(self, size: int, x, y):
-        scale, ox, oy = self.grid_transform(size)
-        j = np.clip(((np.asarray(x) - ox) * scale).astype(int), 0, size - 1)
-        i = np.clip((size - (np.asarray(y) - oy) * scale).astype(int), 0, size - 1)
-        return i, j
+        """The pixel ``(i, j)`` (row, column) of :meth:`raster`'s grid holding world points."""
+        return pixel_of(self.grid_transform(size), size, x, y)
+
+
+def pixel_of(transform, size: int, x, y) -> tuple[np.ndarray, np.ndarray]:
+    """The pixels ``(i, j)`` (row, column) of a ``size`` grid holding world points ``(x, y)``,
+    clipped to the grid; ``transform`` = ``(scale, ox, oy)`` (:meth:`World.grid_transform`),
+    or an array of them ``(k, 3)``, one per point (per row of ``(k, B)`` points)."""
+    scale, ox, oy = np.asarray(transform, dtype=float).T
+    if np.ndim(x) == 2:
+        scale, ox, oy = scale[:, None], ox[:, None], oy[:, None]
+    j = np.clip(((np.asarray(x) - ox) * scale).astype(int), 0, size - 1)
+    i = np.clip((size - (np.asarray(y) - oy) * scale).astype(int), 0, size - 1)
+    return i, j
+
+
+def hint_blocked(x, y, cx, cy, clear, space) -> np.ndarray:
+    """Where the segment from each pose ``(x, y)`` to its pixel centre ``(cx, cy)`` (clearance
+    ``clear``, 0 outside the robot's space; world frame) leaves the robot's ``space`` (an
+    array of geometries, one per pose).  The segment lies in the disc of its length around
+    the centre, so only where that disc reaches the boundary is there something to test."""
+    bad = ~(clear > np.hypot(x - cx, y - cy))
+    test = np.flatnonzero(bad & (clear > 0.0))
+    if len(test):
+        seg = shapely.linestrings(
+            np.stack(
+                [np.column_stack([x[test], y[test]]), np.column_stack([cx[test], cy[test]])],
+                axis=1,
+            )
+        )
+        bad[test] = ~shapely.covers(space[test], seg)
+    return bad
 
 
 def _anchor(g: shapely.Geometry) -> tuple[float, float]:
