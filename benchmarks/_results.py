@@ -58,6 +58,7 @@ NAMES = (
     "certified",
     "navigate_hint",
     "recognize_hint",
+    "recognize_dagger",
 )
 
 

@@ -75,9 +75,19 @@ def main(
         help="more training seeds of the --models' configs (zips): per config trained at "
         "several seeds, the IQM over its seeds per split, and each seed's path ratio",
     )
+    ap.add_argument(
+        "--keep",
+        nargs="+",
+        default=[],
+        metavar="POLICY",
+        help=f"policies of the tracked benchmarks/results/{name}.json (as named there) whose "
+        "rows are taken from it instead of played again, each with every training seed of its "
+        "config; that run must have played the same --episodes and --seed",
+    )
     _results.add_output_args(ap, name)
     args = ap.parse_args(argv)
     t0 = time.perf_counter()
+    kept = _kept(name, args.keep, args.episodes, args.seed) if args.keep else None
     extra = [str(m) for m in args.seed_models]
     specs = [str(m) for m in args.models] + extra + [*rules, "oracle"]
     paths = env == ENV  # the path over the oracle's: Navigate's target
@@ -131,9 +141,75 @@ def main(
         "seeds": seeds,
         "seconds": round(time.perf_counter() - t0, 1),
     }
+    if kept is not None:
+        data = _merge(data, kept)
     _results.write(name, data, args.out, args.update_results)
     print(render(data))
     return 0
+
+
+def _kept(name: str, keep: list[str], episodes: int, seed: int) -> dict[str, Any]:
+    """The part of the tracked data of ``name`` that ``--keep`` names: the policies' rows,
+    their configs' IQM and seed rows, and where they come from.  Raises ``ValueError`` when
+    that run played other episodes or lacks a policy."""
+    old = _results.load(name)
+    first = old["rows"][0]
+    if first["episodes"] != episodes or _arg(old["command"], "--seed", "0") != str(seed):
+        raise ValueError(
+            f"--keep: benchmarks/results/{name}.json played {first['episodes']} episodes from "
+            f"seed {_arg(old['command'], '--seed', '0')} (`{old['command']}`), this run "
+            f"{episodes} from seed {seed}: run those policies again instead"
+        )
+    missing = [p for p in keep if p not in old["policies"]]
+    if missing:
+        raise ValueError(
+            f"--keep: no policy {', '.join(missing)} in benchmarks/results/{name}.json "
+            f"(it holds {', '.join(old['policies'])})"
+        )
+    configs = {r["config"] for r in old.get("iqm") or [] if set(r["policies"]) & set(keep)}
+    return {
+        "policies": list(keep),
+        "order": old["policies"],
+        "rows": [r for r in old["rows"] if r["policy"] in keep],
+        "iqm": [r for r in old.get("iqm") or [] if r["config"] in configs],
+        "seeds": [r for r in old.get("seeds") or [] if r["config"] in configs],
+        "from": {"command": old["command"], "seconds": old["seconds"]},
+    }
+
+
+def _arg(command: str, flag: str, default: str) -> str:
+    words = command.split()
+    return words[words.index(flag) + 1] if flag in words[:-1] else default
+
+
+def _merge(data: dict[str, Any], kept: dict[str, Any]) -> dict[str, Any]:
+    """``data`` of this run with the ``kept`` policies' rows added, in the tracked run's order
+    (a policy both played and kept, or a config of both, raises ``ValueError``)."""
+    both = set(kept["policies"]) & set(data["policies"])
+    clash = {r["config"] for r in kept["iqm"]} & {r["config"] for r in data["iqm"]}
+    if both or clash:
+        raise ValueError(
+            f"--keep: {', '.join(sorted(both | clash))} both played in this run and kept"
+        )
+    order = [p for p in kept["order"] if p in kept["policies"] or p in data["policies"]]
+    new = [p for p in data["policies"] if p not in order]
+    tail = [p for p in order if p in ("hint-rule", "oracle")]
+    order = [p for p in order if p not in tail] + new + tail
+    rank = {p: i for i, p in enumerate(order)}
+    splits = list(dict.fromkeys(r["split"] for r in data["rows"]))
+    if {r["split"] for r in kept["rows"]} != set(splits):
+        raise ValueError("--keep: the tracked run played other splits than this one")
+    rows = sorted(
+        data["rows"] + kept["rows"], key=lambda r: (splits.index(r["split"]), rank[r["policy"]])
+    )
+    return {
+        **data,
+        "policies": order,
+        "rows": rows,
+        "iqm": data["iqm"] + kept["iqm"],
+        "seeds": data["seeds"] + kept["seeds"],
+        "kept": {"policies": kept["policies"], **kept["from"]},
+    }
 
 
 def render(data: dict[str, Any]) -> str:
@@ -170,6 +246,12 @@ def render(data: dict[str, Any]) -> str:
         "",
         f"Measured with `{data['command']}` ({data['seconds']} s).",
     ]
+    if data.get("kept"):
+        k = data["kept"]
+        lines[-1] += (
+            f" The rows of {', '.join(f'`{p}`' for p in k['policies'])} (and their seeds) are "
+            f"kept from the earlier run `{k['command']}` ({k['seconds']} s) on the same episodes."
+        )
     for config in dict.fromkeys(r.get("config") for r in data.get("iqm") or []):
         lines += ["", *_seeds_table(data, config, splits, paths)]
     return "\n".join(lines) + "\n"

@@ -71,6 +71,11 @@ __all__ = [
 
 CONFIG = Path(__file__).resolve().parent.parent / "configs" / "imitation.yaml"
 METHODS = ("bc", "dagger", "dagger+ppo", "ppo")
+#: the log standard deviation a policy of ``bc`` / ``dagger`` is saved with (the fit sets the
+#: Gaussian's mean only; SB3's ``predict`` samples unless ``deterministic=True``, and the
+#: initial spread, 1, would drown the imitated actions): a config's ``dagger.log_std``
+#: overrides it
+IMITATED_LOG_STD = -3.0
 LOSSES = ("mse", "nll")
 
 
@@ -486,6 +491,9 @@ def train_imitation(
         )
         record["imitation"] = res.history
         record["imitation_s"] = round(time.perf_counter() - t0, 1)
+        if method != "dagger+ppo":  # the fit sets the mean only: a narrow spread to keep
+            with torch.no_grad():
+                model.policy.log_std.fill_(float(d.get("log_std", IMITATED_LOG_STD)))
     if method in ("dagger+ppo", "ppo"):
         ft = dict(cfg.get("finetune") or {})
         if method == "dagger+ppo" and ft.get("log_std") is not None:

@@ -220,9 +220,18 @@ class RandomPolicy:
 
 
 #: policy specs that name a fixed controller, with the config it is played with (its
-#: observation kwargs): ``"hint-rule"`` (:mod:`agents.planning.hint_rule`)
+#: observation kwargs): ``"hint-rule"`` (:mod:`agents.planning.hint_rule`; Navigate-v0 ignores
+#: the evidence flags Recognize-v0's rule reads)
 RULES = {
-    "hint-rule": {"algo": "hint_rule", "env_kwargs": {"view_hint": True, "aim_features": True}}
+    "hint-rule": {
+        "algo": "hint_rule",
+        "env_kwargs": {
+            "view_hint": True,
+            "aim_features": True,
+            "map_evidence": True,
+            "self_features": True,
+        },
+    }
 }
 
 

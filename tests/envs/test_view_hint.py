@@ -97,9 +97,52 @@ def test_hint_rule_is_a_policy_spec():
     assert rule["kind"] == "rule" and rule["success_rate"] == 1.0
     with pytest.raises(ValueError, match="view_hint=True and aim_features=True"):
         HintRulePolicy(gym.make("sensorplan/Navigate-v0", scene="lab", view_hint=True))
-    with pytest.raises(ValueError, match="Navigate-v0"):
+    with pytest.raises(ValueError, match="Recognize-v0 made with .*map_evidence=True"):
         HintRulePolicy(gym.make("sensorplan/Recognize-v0", scene="lab", view_hint=True,
                                 aim_features=True))  # fmt: skip
+    with pytest.raises(ValueError, match="Navigate-v0 and Recognize-v0"):
+        HintRulePolicy(gym.make("sensorplan/Placement-v0", scene="lab"))
+
+
+def test_hint_rule_declares_in_recognize():
+    """In Recognize-v0 the rule drives along the hint and declares the side its evidence
+    flags show: right on lab from random starts (16 beams over 360 degrees: it sweeps them
+    over the gaps between them) and with a 75-degree sensor (the narrowest of the benchmark's
+    ``narrow`` splits at which lab has a recognizing pose)."""
+    pytest.importorskip("yaml")
+    from agents.evaluation.evaluate import evaluate
+
+    for extra in ({}, {"fov_deg": 75.0}):
+        res = evaluate(
+            "sensorplan/Recognize-v0", ["hint-rule"], episodes=12, out=False, plot=False,
+            verbose=False, env_kwargs={"scene": "lab", "random_start": True, **extra},
+        )  # fmt: skip
+        assert res["policies"][0]["success_rate"] == 1.0, extra
+
+
+def test_hint_rule_reads_the_evidence_flags():
+    """The decide command follows the flags of the last frame: G only -> G, H only -> H,
+    none or both (a beam in both hulls) -> go on, standing still while pointing."""
+    from agents.planning.hint_rule import POINT_G, POINT_H, RECOGNIZE_KWARGS, HintRulePolicy
+
+    env = gym.make("sensorplan/Recognize-v0", scene="lab", self_features=True,
+                   **RECOGNIZE_KWARGS)  # fmt: skip
+    rule = HintRulePolicy(env)
+    o, _ = env.reset(seed=0)
+    n = env.unwrapped.batch.sensor(0).n_beams
+    o = np.tile(o, (4, 1))
+    ev = rule.evidence
+    flags = np.zeros((4, 2 * n))
+    flags[0, 3] = 1  # a G beam
+    flags[1, n + 5] = 1  # an H beam
+    flags[3, [2, n + 2]] = 1  # one beam in both hulls
+    o[:, ev] = flags
+    a, _ = rule.predict(o)
+    assert a[:, 3].tolist() == [POINT_G, POINT_H, 0.0, 0.0]
+    assert np.all(a[:2, :3] == 0.0)
+    # stacked frames: the rule reads the last one
+    b, _ = rule.predict(np.concatenate([np.zeros_like(o), o], axis=1))
+    np.testing.assert_array_equal(a, b)
 
 
 @pytest.mark.parametrize(

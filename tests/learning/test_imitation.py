@@ -219,6 +219,13 @@ def test_cli_dataset_record_and_imitate_entry(tmp_path, capsys):
         ]
     )
     assert rc == 0 and (tmp_path / "bc" / "final_model.zip").is_file()
+    # saved with a narrow spread: SB3's sampling predict stays near the imitated mean
+    from stable_baselines3 import PPO
+
+    from agents.learning.imitation import IMITATED_LOG_STD
+
+    model = PPO.load(tmp_path / "bc" / "final_model.zip", device="cpu")
+    assert np.all(model.policy.log_std.detach().numpy() == np.float32(IMITATED_LOG_STD))
 
 
 def test_dagger_from_the_hint_rule_fits_the_rule_labels():
