@@ -193,7 +193,7 @@ def _merge(data: dict[str, Any], kept: dict[str, Any]) -> dict[str, Any]:
         )
     order = [p for p in kept["order"] if p in kept["policies"] or p in data["policies"]]
     new = [p for p in data["policies"] if p not in order]
-    tail = [p for p in order if p in ("hint-rule", "oracle")]
+    tail = [p for p in order if p in ("hint-rule", "hint-rule-turn", "oracle")]
     order = [p for p in order if p not in tail] + new + tail
     rank = {p: i for i, p in enumerate(order)}
     splits = list(dict.fromkeys(r["split"] for r in data["rows"]))

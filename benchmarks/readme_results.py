@@ -38,11 +38,12 @@ LABELS = {
     "dagger_oracle_s0": "DAgger from the oracle",
     "ppo_navigate_hint": "PPO from scratch (same observation)",
     "ppo_navigate_hard": "PPO from scratch, no map features",
-    "dagger_recognize_hint": "DAgger from the hint rule (shipped)",
+    "dagger_recognize_hint": "DAgger from the hint rule turning to each hull (shipped)",
     "ppo_recognize_hint": "PPO from scratch (shipped too)",
     "ppo_recognize_hard": "PPO from scratch, no map features",
     "pixel policy": "pixel-action BC (shipped)",
     "hint-rule": "hint rule (fixed, no learning)",
+    "hint-rule-turn": "hint rule turning to each hull (fixed, no learning)",
     "oracle": "oracle (exact planner)",
 }
 FAMILIES = (("bundled", "ood:"), ("real maps", "real:"), ("narrow FOV", "narrow:"))
@@ -72,7 +73,7 @@ def _rows(data: dict[str, Any], paths: bool) -> list[dict[str, Any]]:
             ]
         else:
             rate = {r["split"]: r["successes"] / r["episodes"] for r in rows}
-            seeds = 1 if name not in ("oracle", "hint-rule") else None
+            seeds = 1 if name not in ("oracle", "hint-rule", "hint-rule-turn") else None
             ratios = [r["path_ratio"] for r in rows if r.get("path_ratio") is not None]
         fam = {}
         for label, prefix in FAMILIES:
@@ -122,7 +123,7 @@ def _recognize_rows(recs: list[dict[str, Any]]) -> list[dict[str, Any]]:
                 best[name] = row
             if name not in order:
                 order.append(name)
-    last = [LABELS["hint-rule"], LABELS["oracle"]]
+    last = [LABELS["hint-rule"], LABELS["hint-rule-turn"], LABELS["oracle"]]
     return [best[n] for n in order if n not in last] + [best[n] for n in last if n in best]
 
 

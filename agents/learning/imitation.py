@@ -232,7 +232,7 @@ def make_expert(expert: str, venv: gym.vector.VectorEnv) -> Any:
     ``ValueError`` listing the choices."""
     if expert == "oracle":
         return OraclePolicy(venv)
-    if expert == "hint-rule":
+    if expert in RULES:
         from ..planning.hint_rule import HintRulePolicy
 
         return HintRulePolicy(venv)

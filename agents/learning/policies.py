@@ -231,7 +231,18 @@ RULES = {
             "map_evidence": True,
             "self_features": True,
         },
-    }
+    },
+    # Recognize-v0 only: the hint to poses that see both hulls with no joint aim asked
+    "hint-rule-turn": {
+        "algo": "hint_rule",
+        "env_kwargs": {
+            "view_hint": True,
+            "hint_aim": False,
+            "aim_features": True,
+            "map_evidence": True,
+            "self_features": True,
+        },
+    },
 }
 
 
@@ -271,6 +282,7 @@ OBSERVATION_KWARGS = (
     "hull_views",
     "aim_views",
     "view_hint",
+    "hint_aim",
 )
 
 
@@ -378,7 +390,7 @@ def load_policy(spec: str, env, *, seed: int = 0, device: str = "cpu"):
         return OraclePolicy(env)
     if spec == "random":
         return RandomPolicy(env.action_space, seed=seed, observation_space=env.observation_space)
-    if spec == "hint-rule":
+    if spec in RULES:
         from ..planning.hint_rule import HintRulePolicy
 
         return HintRulePolicy(env)

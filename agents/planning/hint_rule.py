@@ -17,11 +17,14 @@ spacing per step; one whose field of view exceeds the joint arc by more than a f
 (``max_turn``) turns the same way while the arc's centre lies less than half a turn step
 behind the heading and turns back a full step otherwise, a saw-tooth of one turn step's width
 around the arc's centre that keeps both hulls in view (memoryless: a function of the
-observation, as a DAgger label must be).  It reads the observation only, not the recognizable
-region nor where the target is, so it shows what those features give by themselves: the
-baseline a learned policy on the same observation should beat, and a labeller for DAgger
-that a learner can fit exactly.  ``sensorplan evaluate`` / ``benchmark`` play it as the policy
-spec ``"hint-rule"``.
+observation, as a DAgger label must be); one narrower than the joint arc (a ``view_hint``
+made with ``hint_aim=False`` leads to poses with no joint aim) turns round, a few beam
+spacings per step, so that each hull comes into view in turn.  It reads the observation
+only, not the recognizable region nor where the target is, so it shows what those features
+give by themselves: the baseline a learned policy on the same observation should beat, and a
+labeller for DAgger that a learner can fit exactly.  ``sensorplan evaluate`` / ``benchmark``
+play it as the policy spec ``"hint-rule"``, and in Recognize-v0 with ``hint_aim=False`` as
+``"hint-rule-turn"``.
 """
 
 from __future__ import annotations
@@ -129,6 +132,13 @@ class HintRulePolicy:
             back = err <= -0.5 * self.max_turn
             turn = np.where(scan & full, self.scan_turn, turn)
             turn = np.where(saw, np.where(back, -1.0, self.scan_turn), turn)
+            # the two hulls do not fit in the field of view at once: turn round, one hull
+            # after the other, at SCAN_TURN past a whole number of beam spacings per step
+            gap = fov / max(self.n_beams - 1, 1)
+            step = (np.floor(0.8 * self.max_turn / gap) + SCAN_TURN) * gap
+            turn = np.where(
+                scan & ~full & (slack < 0.0), np.minimum(step / self.max_turn, 1.0), turn
+            )
         still = decide != GO_ON  # keep the beams that read the target where they are
         act = np.column_stack(
             [

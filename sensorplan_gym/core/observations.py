@@ -107,8 +107,10 @@ class RobotVectorObs:
         self_features: bool = False,
         aim_features: bool = False,
         view_hint: bool = False,
+        hint_aim: bool = True,
     ) -> None:
         self.n = n_beams
+        self.hint_aim = hint_aim
         n = n_beams
         self.aim_features = aim_features
         self.view_hint = view_hint
@@ -162,7 +164,7 @@ class RobotVectorObs:
         if self.aim_features:
             parts.append(aim_features(sim.hulls[sel], sim.reach[sel], x, y, psi))
         if self.view_hint:
-            parts.append(view_hint(sim.worlds[sel], x, y, psi))
+            parts.append(view_hint(sim.worlds[sel], x, y, psi, self.hint_aim))
         return np.concatenate(parts, axis=1)
 
     def _numpy(self, sim: BatchSim, idx: np.ndarray) -> np.ndarray:
@@ -269,7 +271,7 @@ def aim_features(hulls: np.ndarray, reach: np.ndarray, x, y, psi) -> np.ndarray:
     return out
 
 
-def view_hint(worlds: list[World], x, y, psi) -> np.ndarray:
+def view_hint(worlds: list[World], x, y, psi, aim: bool = True) -> np.ndarray:
     """``(k, 3)`` float64: the ``view_hint`` of poses ``(x, y, psi)`` (world frame, radians)
     in ``worlds`` (one per pose): the way to the nearest pixel that sees every corner of K_G
     and K_H with a passing aim, along the shortest grid path in the robot's free space
@@ -311,11 +313,11 @@ def view_hint(worlds: list[World], x, y, psi) -> np.ndarray:
         b = bad[rows]
         if b.any():
             r = np.asarray(rows)[b]
-            i[b], j[b] = w.hint_search(x[r], y[r], i[b], j[b], HINT_SIZE)
+            i[b], j[b] = w.hint_search(x[r], y[r], i[b], j[b], HINT_SIZE, aim)
             X, Y = w.pixel_centres(HINT_SIZE)
             centre[r] = np.column_stack([X[i[b], j[b]], Y[i[b], j[b]]])
             clear[r] = w.hint_clearance(HINT_SIZE)[i[b], j[b]]
-        ways[:, rows] = w.hint_field(HINT_SIZE)[0][:, i, j]
+        ways[:, rows] = w.hint_field(HINT_SIZE, aim)[0][:, i, j]
     xy = np.column_stack([x, y])
     # the farthest waypoint in plain sight; the nearest, or failing that the pixel's own
     # centre (in sight, unless no pixel nearby is), when none is.  The segment to the
@@ -334,7 +336,7 @@ def view_hint(worlds: list[World], x, y, psi) -> np.ndarray:
         way = np.where(free[:, None], far, way)
     wi, wj = pixel_of(grid, HINT_SIZE, way[:, 0], way[:, 1])
     for rows in groups.values():
-        rest[rows] = worlds[rows[0]].hint_field()[1][wi[rows], wj[rows]]
+        rest[rows] = worlds[rows[0]].hint_field(HINT_SIZE, aim)[1][wi[rows], wj[rows]]
     dx, dy = way[:, 0] - x, way[:, 1] - y
     n = np.hypot(dx, dy)
     left = rest + n  # to the waypoint, then on along the path
@@ -478,12 +480,14 @@ def make_observation(
     hull_views: bool = False,
     aim_views: int = 0,
     view_hint: bool = False,
+    hint_aim: bool = True,
 ):
     """The observation builder for env ``kind`` ("robot" or "placement") and ``obs_type``;
     ``map_ranges`` / ``map_evidence`` / ``sensor_fov`` / ``self_features``: robot vector
     observations carry the map-predicted ranges / the per-beam evidence flags / the field of
     view / the field of view and the reach too / the arcs of K_G and K_H (:func:`aim_features`)
-    / the way to the poses that see both hulls (:func:`view_hint`);
+    / the way to the poses that see both hulls (:func:`view_hint`; ``hint_aim=False``: with
+    no joint aim asked of them);
     Placement's grid: ``grid_views`` / ``hull_views`` / ``aim_views`` (a number of aims) /
     ``self_features`` add channels (:class:`PlacementGridObs`)."""
     if obs_type not in OBS_TYPES:
@@ -518,5 +522,6 @@ def make_observation(
             self_features=self_features,
             aim_features=aim_features,
             view_hint=view_hint,
+            hint_aim=hint_aim,
         )
     return table[(kind, obs_type)](n_beams, grid_size)

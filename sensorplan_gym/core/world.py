@@ -448,7 +448,7 @@ class World:
             self._cache[key] = np.where(ok.reshape(aims, size, size), 255, 0).astype(np.uint8)
         return self._cache[key]
 
-    def hint_field(self, size: int = HINT_SIZE) -> tuple[np.ndarray, np.ndarray]:
+    def hint_field(self, size: int = HINT_SIZE, aim: bool = True) -> tuple[np.ndarray, np.ndarray]:
         """The ``view_hint`` field on :meth:`raster`'s grid of ``size`` pixels: ``(ahead,
         dist)``.  ``dist`` ``(size, size)``: the length (scene units) of the cheapest
         8-connected grid path from a pixel to the nearest *target pixel*, ``inf`` where none
@@ -461,9 +461,12 @@ class World:
         Target pixels: centres in the robot's free space that see every corner of K_G and of
         K_H (:meth:`hull_view_raster`), admit an aim that passes the aim test
         (:meth:`aim_raster`, 16 aims) and lie outside K_G and K_H: map geometry alone, not the
-        recognizable region.  Paths run over pixels whose centres are in the robot's free
-        space; a pixel outside it takes the values of the nearest one inside."""
-        key = f"hint{size}"
+        recognizable region.  ``aim=False`` drops the aim test for the range test alone
+        (every hull vertex within ``max_range``, less ``eps_pos``): poses for a robot that
+        turns to each hull in turn, as Recognize-v0 allows.  Paths run over pixels whose
+        centres are in the robot's free space; a pixel outside it takes the values of the
+        nearest one inside."""
+        key = f"hint{size}" if aim else f"hint{size}noaim"
         got = self._cache.get(key)
         if got is not None:
             return got
@@ -474,7 +477,16 @@ class World:
         X, Y = self.pixel_centres(size)
         space = shapely.contains_xy(self.robot_space, X, Y)
         hv = self.hull_view_raster(size)
-        goal = space & (hv[0] > 0) & (hv[1] > 0) & (self.aim_raster(size, 16) > 0).any(axis=0)
+        goal = space & (hv[0] > 0) & (hv[1] > 0)
+        if aim:
+            goal &= (self.aim_raster(size, 16) > 0).any(axis=0)
+        elif math.isfinite(self.max_range):
+            far = np.zeros_like(X)
+            for h in self.must_see:
+                far = np.maximum(
+                    far, np.hypot(X[..., None] - h[:, 0], Y[..., None] - h[:, 1]).max(-1)
+                )
+            goal &= far + self.eps_pos <= self.max_range
         dist = np.full(size * size, np.inf)
         nxt = np.arange(size * size)  # steepest-descent successor (flat pixel index)
         if goal.any():
@@ -609,7 +621,9 @@ class World:
             got = self._cache[key] = got
         return got
 
-    def hint_cells(self, x, y, size: int = HINT_SIZE) -> tuple[np.ndarray, np.ndarray]:
+    def hint_cells(
+        self, x, y, size: int = HINT_SIZE, aim: bool = True
+    ) -> tuple[np.ndarray, np.ndarray]:
         """The pixels ``(i, j)`` of :meth:`hint_field`'s grid whose paths poses ``(x, y)``
         (world frame) follow: the pixel holding the point when the segment from the point to
         its centre lies in the robot's space (so no wall between them), else
@@ -623,15 +637,18 @@ class World:
         space = np.full(len(x), self.robot_space, dtype=object)
         bad = hint_blocked(x, y, X[i, j], Y[i, j], clear, space)
         if bad.any():
-            i[bad], j[bad] = self.hint_search(x[bad], y[bad], i[bad], j[bad], size)
+            i[bad], j[bad] = self.hint_search(x[bad], y[bad], i[bad], j[bad], size, aim)
         return i, j
 
-    def hint_search(self, x, y, i, j, size: int = HINT_SIZE) -> tuple[np.ndarray, np.ndarray]:
+    def hint_search(
+        self, x, y, i, j, size: int = HINT_SIZE, aim: bool = True
+    ) -> tuple[np.ndarray, np.ndarray]:
         """For poses ``(x, y)`` held by pixels ``(i, j)`` behind a wall: the pixel of the
         5 x 5 around each in the robot's space whose centre the pose sees and whose way on
-        (the segment plus its path) is shortest; the holding pixel where there is none."""
+        (the segment plus its path; :meth:`hint_field` with ``aim``) is shortest; the holding
+        pixel where there is none."""
         i, j = np.array(i), np.array(j)
-        dist = self.hint_field(size)[1]
+        dist = self.hint_field(size, aim)[1]
         X, Y = self.pixel_centres(size)
         inside = self.hint_clearance(size) > 0.0
         shapely.prepare(self.robot_space)

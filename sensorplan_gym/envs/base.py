@@ -83,6 +83,9 @@ view_hint : bool, default False -- Navigate/Recognize vector observations end wi
     to the nearest pose that sees every corner of K_G and K_H with a passing aim (map geometry,
     not the recognizable region): the first step of the shortest grid path there in the robot's
     frame and its length / diameter (:func:`sensorplan_gym.core.observations.view_hint`).
+hint_aim : bool, default True -- with ``view_hint``: its target poses admit one aim that passes
+    the aim test (both hulls in view at once); ``False`` (Recognize-v0 only, which may look at
+    G, then at H): every corner of both hulls seen, and within range, with no joint aim asked.
 aim_features : bool, default False -- Navigate/Recognize vector observations end with the
     arcs of directions that K_G and K_H (the swept hulls) cover from the robot's pose, relative
     to its heading, and their farthest vertex's distance over the reach (see
@@ -350,6 +353,7 @@ class SensorPlanBatch(BatchSim):
         hull_views: bool = False,
         aim_views: bool = False,
         view_hint: bool = False,
+        hint_aim: bool = True,
         **action_kw: Any,
     ) -> None:
         for name, v in (
@@ -415,6 +419,15 @@ class SensorPlanBatch(BatchSim):
                 else f"{name}=True needs obs_type='vector' in Navigate or Recognize"
                 + (" (or Placement)" if name == "self_features" else "")
             )
+        if not isinstance(hint_aim, bool):
+            raise ValueError(f"hint_aim must be True or False, got {hint_aim!r}")
+        if not hint_aim and (not view_hint or self.joint_view):
+            raise ValueError(
+                "hint_aim=False needs view_hint=True"
+                if not view_hint
+                else f"hint_aim=False: {self.task_name} needs one aim at both hulls (its "
+                "success is a joint view); Recognize-v0 may look at G, then at H"
+            )
         self.map_ranges = map_ranges or map_evidence  # the sim computes the map's ranges
         self.params[fused.P_MAP] = self.map_ranges
         self.params[fused.P_OBS_MAP] = map_ranges
@@ -434,6 +447,7 @@ class SensorPlanBatch(BatchSim):
             hull_views=hull_views,
             aim_views=int(action_kw.get("placement_aims", 8)) if aim_views else 0,
             view_hint=view_hint,
+            hint_aim=hint_aim,
         )
         self.single_observation_space = self.obs.space
         self.actions = make_actions(

@@ -219,3 +219,36 @@ def test_hint_does_not_lead_through_a_wall_thinner_than_a_pixel():
         if term or trunc:
             break
     assert info["is_success"], info
+
+
+def test_hint_aim_false_leads_to_views_without_a_joint_aim():
+    """``hint_aim=False`` (Recognize-v0): on lab with a 50-degree sensor no pose sees both
+    hulls in one aim, so the joint hint says "none reachable" (way 1, zero direction), while
+    the hint with no joint aim asked leads somewhere, and the rule that turns to each hull in
+    turn (``hint-rule-turn``) recognizes from there where the joint one cannot; Navigate-v0
+    (whose success is a joint view) and a missing ``view_hint`` are refused."""
+    pytest.importorskip("yaml")
+    from agents.evaluation.evaluate import evaluate
+
+    ways = []
+    for aim in (True, False):
+        env = gym.make("sensorplan/Recognize-v0", scene="lab", fov_deg=50.0, view_hint=True,
+                       hint_aim=aim)  # fmt: skip
+        o, _ = env.reset(seed=0)
+        ways.append(o[-3:])
+    assert ways[0].tolist() == [0.0, 0.0, 1.0]
+    assert 0.0 < ways[1][2] < 1.0 and np.hypot(*ways[1][:2]) > 0.99
+    rates = [
+        evaluate(
+            "sensorplan/Recognize-v0", [spec], episodes=8, out=False, plot=False, verbose=False,
+            env_kwargs={"scene": "lab", "random_start": True, "fov_deg": 50.0},
+        )["policies"][0]["success_rate"]
+        for spec in ("hint-rule", "hint-rule-turn")
+    ]  # fmt: skip
+    assert rates[1] == 1.0 and rates[0] < 0.5, rates
+    with pytest.raises(ValueError, match="NavigateEnv needs one aim at both hulls"):
+        gym.make("sensorplan/Navigate-v0", scene="lab", view_hint=True, hint_aim=False)
+    with pytest.raises(ValueError, match="hint_aim=False needs view_hint=True"):
+        gym.make("sensorplan/Recognize-v0", scene="lab", hint_aim=False)
+    with pytest.raises(ValueError, match="hint_aim must be True or False"):
+        gym.make("sensorplan/Recognize-v0", scene="lab", view_hint=True, hint_aim="no")
