@@ -167,13 +167,17 @@ def _kept(name: str, keep: list[str], episodes: int, seed: int) -> dict[str, Any
             f"(it holds {', '.join(old['policies'])})"
         )
     configs = {r["config"] for r in old.get("iqm") or [] if set(r["policies"]) & set(keep)}
+    source = {"command": old["command"], "seconds": old["seconds"]}
+    earlier = old.get("kept") or {}
+    if set(keep) <= set(earlier.get("policies") or []):  # kept there too: the run that played them
+        source = {"command": earlier["command"], "seconds": earlier["seconds"]}
     return {
         "policies": list(keep),
         "order": old["policies"],
         "rows": [r for r in old["rows"] if r["policy"] in keep],
         "iqm": [r for r in old.get("iqm") or [] if r["config"] in configs],
         "seeds": [r for r in old.get("seeds") or [] if r["config"] in configs],
-        "from": {"command": old["command"], "seconds": old["seconds"]},
+        "from": source,
     }
 
 

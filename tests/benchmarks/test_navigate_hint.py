@@ -99,6 +99,11 @@ def test_keep_takes_rows_and_seeds_from_the_tracked_run(monkeypatch):
     text = navigate_hint.render(data)
     assert "`old`'s recipe over 2 training seeds" in text
     assert "kept from the earlier run `python -m benchmarks.navigate_hint --episodes 10`" in text
+    # keeping again from that merged data names the run that played them
+    monkeypatch.setattr(navigate_hint._results, "load", lambda name: data)
+    again = navigate_hint._kept("navigate_hint", ["old"], 10, 0)
+    assert again["from"]["command"] == tracked["command"]
+    monkeypatch.setattr(navigate_hint._results, "load", lambda name: tracked)
     with pytest.raises(ValueError, match="played 10 episodes from seed 0"):
         navigate_hint._kept("navigate_hint", ["old"], 100, 0)
     with pytest.raises(ValueError, match="no policy nope"):
