@@ -33,8 +33,9 @@ __all__ = ["EXTRA_OF_MODULE", "build_parser", "main"]
 
 ENV_CHOICES_HELP = "sensorplan/Placement-v0, sensorplan/Navigate-v0 or sensorplan/Recognize-v0"
 POLICIES_HELP = (
-    "'oracle', 'random', 'hint-rule' (Navigate-v0: a fixed controller on the view_hint and "
-    "aim_features observations) and/or paths to model zips or pixel policies (.pt)"
+    "'oracle', 'random', 'hint-rule' (Navigate-v0 and Recognize-v0: a fixed controller on the "
+    "view_hint, aim_features and evidence observations), 'hint-rule-turn' (Recognize-v0, on "
+    "view_hint with hint_aim=False) and/or paths to model zips or pixel policies (.pt)"
 )
 
 
