@@ -43,7 +43,8 @@ component that neither neighbouring shadow meets (a shadow born and gone in
 between), and once between consecutive *collinearity events* (:meth:`Sweeper._events`:
 a moving anchor crossing a line through two obstacle corners or an obstacle edge, a line
 through two target vertices crossing a corner), where a shadow can be born as a segment
-that continues a known shadow edge (issue 26.3, 26.4), and just after a traced edge was
+that continues a known shadow edge (issue 26.3, 26.4) -- next to the events whose lines
+carry a shadow edge at some sample (:meth:`Sweeper._live_mids`) --, and just after a traced edge was
 cut short by the death of a neighbour while its line still bounds a shadow (the edge goes
 on with another neighbour, a configuration that may live between two samples only:
 :meth:`Sweeper._continuation_gap`).  What this does not prove is listed in
@@ -110,6 +111,18 @@ def _meet(a0: np.ndarray, a1: np.ndarray, b0: np.ndarray, b1: np.ndarray) -> np.
 
 
 @dataclass
+class _Cover:
+    """What the traces of one edge of the region covered (:meth:`Sweeper._sweep_intervals`):
+    per line key the intervals covered (``cover``) and reached by traces (``traced``),
+    the confirmed ``(t, key)`` pairs and the cut traces already sampled after (``probed``)."""
+
+    cover: dict[tuple, list] = field(default_factory=dict)
+    confirmed: set[tuple] = field(default_factory=set)
+    traced: dict[tuple, list] = field(default_factory=dict)
+    probed: list[tuple] = field(default_factory=list)
+
+
+@dataclass
 class Sweeper:
     """Swept shadows of one target (fixed orientation) moving along segments.
 
@@ -138,6 +151,9 @@ class Sweeper:
     max_depth: int = 6
     bisect_steps: int = 14
     probes: int = 4
+    #: sample only next to the collinearity events whose wedge lines carry a shadow edge
+    #: (:meth:`_live_mids`); False: next to every event (the reference the tests compare with)
+    lazy_events: bool = True
     #: ``time.monotonic()`` value after which the sweep stops (None: no limit).
     deadline: float | None = None
     _cut_segs: np.ndarray = field(init=False, repr=False)
@@ -642,21 +658,86 @@ class Sweeper:
         if not float(np.hypot(*dq)) > 0:
             return [frames[0.0][0]], stats
         ts = self._refine_births(ts, q0, dq, frame, stats)
-        # one sample between consecutive collinearity events (shadows born on a line)
-        ev = np.concatenate([[0.0], self._events(q0, dq), [1.0]])
-        mids = {float(t) for t in 0.5 * (ev[1:] + ev[:-1])}
-        ts = sorted(set(ts) | mids)
-        self._prefetch([q1 if t == 1.0 else q0 + t * dq for t in ts])
-        for t in ts:
-            frame(t)
-        pieces = [frames[t][0] for t in ts]
-        cover: dict[tuple, list] = {}
-        # (t, key): an edge on that line at sample t is confirmed by the exact point test
-        # (its trace lives past t) or swept inside the known shadows
-        confirmed: set[tuple] = set()
-        traced: dict[tuple, list] = {}  # key -> the intervals its traces reached
-        probed: list[tuple] = []  # (key, t_end) of the cut traces already sampled after
+        # the collinearity events (shadows born on a line) are sampled lazily: once
+        # between consecutive events next to a *live* event, one whose wedge's lines carry
+        # a shadow edge at a sample so far (see _live_mids), until no new one is live;
+        # first from the samples alone, then again after the refinements of the tracing
+        ev_t, ev_ids = self._events(q0, dq)
+        looked: set[int] = set()
+        while mids := self._live_mids(ev_t, ev_ids, frames, looked):
+            self._prefetch([q0 + t * dq for t in mids])
+            for t in mids:
+                frame(t)
+        ts = sorted(frames)
+        pieces = [frame(t)[0] for t in ts]
+        state = _Cover()
         todo = [(a, b, 0) for a, b in zip(ts[:-1], ts[1:], strict=True)]
+        while True:
+            self._sweep_intervals(todo, q0, q1, frame, pieces, state, stats)
+            mids = self._live_mids(ev_t, ev_ids, frames, looked)
+            if not mids:
+                return pieces, stats
+            self._prefetch([q0 + t * dq for t in mids])
+            for t in mids:
+                pieces.append(frame(t)[0])
+            grid = sorted(set(frames) | set(mids))
+            todo = [
+                (a, b, 0)
+                for a, b in zip(grid[:-1], grid[1:], strict=True)
+                if a in mids or b in mids
+            ]
+
+    def _live_mids(
+        self, ev_t: np.ndarray, ev_ids: list, frames: dict, looked: set[int]
+    ) -> list[float]:
+        """The sample times (sorted, not sampled yet) that the collinearity events
+        :meth:`_events` asks for now: the midpoint of each interval between consecutive
+        events (0 and 1 included) next to a live event that holds no sample yet.
+
+        An event (index into ``ev_t``) is *live* when a shadow edge at a sample so far
+        (``frames``: time -> (shadow, edges); the edge or one of its neighbours) lies on a
+        line spanned by two of its anchors, one of them moving (:meth:`_events`' ids; an
+        unknown id, -1, makes it live; ``lazy_events=False``: every event is).  The wedge
+        that opens at an event grows from a line that continues an edge of an existing
+        shadow, and that edge lies on such a line, so an event none of whose lines
+        carries a shadow edge at any sample opens no wedge *unless* that edge itself is
+        born and gone between samples: the rule assumes it is not (measured, not proven:
+        docs/DESIGN.md, "Collinearity events").  The caller samples, then asks again (the
+        new samples can make more events live); each event is looked at until it is live
+        once (``looked``)."""
+        keys = {frozenset(k) for _, es in frames.values() for e in es for k in e}
+        bounds = np.concatenate([[0.0], ev_t, [1.0]])
+        times = np.array(sorted(frames))
+        out: set[float] = set()
+        for k in range(len(ev_t)):
+            if k in looked:
+                continue
+            live = not self.lazy_events
+            for mov, other in ev_ids[k]:
+                if -1 in mov or -1 in other:
+                    live = True
+                    break
+                if any(frozenset((u, v)) in keys for u in mov for v in (*mov, *other) if v != u):
+                    live = True
+                    break
+            if not live:
+                continue
+            looked.add(k)
+            for lo, hi in ((bounds[k], bounds[k + 1]), (bounds[k + 1], bounds[k + 2])):
+                if not ((times > lo) & (times < hi)).any():
+                    out.add(float(0.5 * (lo + hi)))
+        return sorted(out)
+
+    def _sweep_intervals(
+        self, todo: list, q0: np.ndarray, q1: np.ndarray, frame, pieces: list, state, stats
+    ) -> None:
+        """Trace the moving shadow edges over the intervals ``todo`` ((a, b, depth) each,
+        sample times of the sweep ``q0 -> q1``), refining where a configuration may be
+        born and gone in between; the traced quads and the refinement samples' shadows
+        go to ``pieces``.  ``state`` (:class:`_Cover`) carries what the traces covered
+        from one call to the next."""
+        dq = q1 - q0
+        cover, confirmed, traced, probed = state.cover, state.confirmed, state.traced, state.probed
         while todo:
             self._check_time()
             a, b, depth = todo.pop()
@@ -692,26 +773,27 @@ class Sweeper:
             if gap is None:
                 gap = self._continuation_gap(cut, traced, probed, q0, dq)
             if gap is not None and depth < self.max_depth:
-                frame(gap)
                 stats["refined"] += 1
-                pieces.append(frames[gap][0])
+                pieces.append(frame(gap)[0])
                 todo += [(a, gap, depth + 1), (gap, b, depth + 1)]
-        return pieces, stats
 
-    def _events(self, q0: np.ndarray, dq: np.ndarray) -> np.ndarray:
+    def _events(self, q0: np.ndarray, dq: np.ndarray) -> tuple[np.ndarray, list]:
         """Times in (0, 1), sorted, at which the target moving along ``q0 + t dq`` meets
         a *collinearity event*: a moving anchor (target vertex or end of a wanted piece)
         crosses the line through two convex obstacle corners whose joining line is
         tangent at both, or through an obstacle edge; or the line through two target
         vertices crosses a convex obstacle corner.  Only events whose line is
-        unobstructed between its anchors count.
+        unobstructed between its anchors count.  Also, per time, the anchor ids of its
+        events: ``(moving ids, other ids)`` each (ids as :meth:`pos` takes them; -1: the
+        neighbour of an obstacle corner not known), for :meth:`_live_mids`.
 
         At such an event two shadow-edge lines coincide, and a shadow can be born as a
         segment on that line (it then grows from a line that continues an edge of an
         existing shadow, so the eroded-target test of :meth:`_refine_births`, which
         looks for shadow components apart from the known ones, does not see it: fuzz
         issue 26.3/26.4).  Sampling once between consecutive events catches such a
-        shadow at a time it has area, and its edges are then traced both ways."""
+        shadow at a time it has area, and its edges are then traced both ways (next to
+        the events :meth:`_live_mids` finds live)."""
         b, i, j = self._event_lines()
         env = self.env
         # obstacle edges with a convex end (a beam can graze along them past that end)
@@ -765,7 +847,7 @@ class Sweeper:
         segs = np.concatenate([seg_a, seg_b])
         t = np.concatenate([ta, tb])
         if len(t) == 0:
-            return t
+            return t, []
         keep = self._tangent_events(xa, ta, la, w, lb, pb, b, ii, kk)
         idx = np.flatnonzero(keep)  # the covering test only where the tangency holds
         keep[idx] = shapely.covers(self._free_near(), shapely.linestrings(segs[idx]))
@@ -784,10 +866,57 @@ class Sweeper:
                 np.einsum("ij,ij->i", d_s, d_s), 1e-300
             )
             keep[cut] &= (u_e >= -1e-9) & (u_e <= 1 + 1e-9) & (w_e >= -1e-9) & (w_e <= 1 + 1e-9)
-        t = np.unique(t[keep])
-        if len(t) > 1:  # merge events closer than the tracing can tell apart
-            t = t[np.concatenate([[True], np.diff(t) > 1e-9])]
-        return t
+        # the anchor ids of each event: the moving ones and the others (lines through two
+        # of them carry the edges of the wedge that opens there, see _live_mids)
+        n = self.n_fixed
+        mov_id = n + np.arange(self.m)
+        if len(self._cut_segs):
+            mov_id = np.concatenate([mov_id, n + self.m + np.flatnonzero(ok)])
+        nxt, prv = self._ring_neighbours()
+        fix = np.vstack(
+            [
+                np.stack([cvx[i], cvx[j]], axis=1),
+                np.stack([cvx, nxt[cvx]], axis=1),
+                np.stack([cvx, prv[cvx]], axis=1),
+            ]
+        )
+        ids = [((int(mov_id[x]),), tuple(fix[k].tolist())) for x, k in zip(xa, la, strict=True)]
+        ids += [
+            ((n + int(ii[p]), n + int(kk[p])), (int(cvx[k]),)) for p, k in zip(pb, lb, strict=True)
+        ]
+        kept = np.flatnonzero(keep)
+        kept = kept[np.argsort(t[kept], kind="stable")]
+        ts = t[kept]
+        # merge events closer than the tracing can tell apart (the first time stands)
+        first = np.concatenate([[True], np.diff(ts) > 1e-9]) if len(ts) else np.zeros(0, bool)
+        group = np.cumsum(first) - 1
+        out: list[list] = [[] for _ in range(int(first.sum()))]
+        for g, c in zip(group, kept, strict=True):
+            out[g].append(ids[c])
+        return ts[first], out
+
+    def _ring_neighbours(self) -> tuple[np.ndarray, np.ndarray]:
+        """(len(env.vert),) indices of each environment vertex's next and previous vertex
+        along its ring, -1 where the domain's rings are not stored one after the other
+        (cached)."""
+        got = getattr(self, "_neighbours", None)
+        if got is None:
+            env = self.env
+            r = np.asarray(env.vert_ring)
+            idx = np.arange(len(r))
+            nxt = np.full(len(r), -1)
+            prv = np.full(len(r), -1)
+            if len(r) and (np.diff(r) >= 0).all():
+                first = np.searchsorted(r, r, side="left")
+                last = np.searchsorted(r, r, side="right") - 1
+                n_ = np.where(idx == last, first, idx + 1)
+                p_ = np.where(idx == first, last, idx - 1)
+                ok_n = (env.vert[n_] == env.vert_next).all(axis=1)
+                ok_p = (env.vert[p_] == env.vert_prev).all(axis=1)
+                nxt[ok_n] = n_[ok_n]
+                prv[ok_p] = p_[ok_p]
+            got = self._neighbours = (nxt, prv)
+        return got
 
     def _tangent_events(self, xa, ta, la, w, lb, pb, b, ii, kk) -> np.ndarray:
         """Which events can bound a shadow: the moving vertex's line is tangent to the

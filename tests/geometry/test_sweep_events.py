@@ -1,0 +1,142 @@
+"""The collinearity events of the swept partial query (paper 3.2.2-3.2.3, 5.2) and their lazy
+sampling (issue 25 item 1): :meth:`geometry.sweep.Sweeper._events` names the anchors of
+every event, and sampling only next to the events whose lines carry a shadow edge
+(:meth:`~geometry.sweep.Sweeper._live_mids`) gives the regions that sampling next to every
+event gives, on the reproductions of the fuzz findings the event samples were made for
+(issue 26.3, 26.4, 25.7), the bundled scenes and a real map."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+import shapely
+
+from geometry import Scene, partial_region, recognizable_region
+from geometry import sweep as S
+from geometry.fuzz import fuzz_scene
+from sensorplan_gym.core.scenes import load_scene
+
+REPRO = Path(__file__).parent / "fuzz_repro"
+
+#: The fuzz reproductions whose root cause was a shadow born on an event line (DESIGN.md,
+#: "Collinearity events"), a bundled scene and a real map with many events.
+SCENES = [
+    "fuzz-disagree-P_swept-lib_in_truth_out",
+    "fuzz-inclusion-swept_partial__stationary_partial_aux_",
+    "fuzz-inclusion-recognizable_partial__partial_G_",
+    "recognizable_not_in_RG",
+    "recognizable_moves_with_frame",
+    "swept_point_birth_frame",
+    "lab",
+    "real/heidelberg_l2",
+    "fuzz:200326",
+]
+
+
+def _scene(name: str) -> Scene:
+    if name.startswith("fuzz:"):  # a scene of the swept fuzz (contact families)
+        d = fuzz_scene(int(name.removeprefix("fuzz:")), contacts=True)
+        return Scene.from_dict({k: v for k, v in d.items() if k != "features"})
+    path = REPRO / f"{name}.json"
+    if path.is_file():
+        d = json.loads(path.read_text())
+        return Scene.from_dict(d.get("scene", d))
+    return load_scene(name)
+
+
+def _queries(scene: Scene) -> dict[str, shapely.Geometry]:
+    """The swept partial region over G and the 5.2 region, ``conservative=True``: the traced
+    quads and the samples leave cracks narrower than ``tol`` between them, which differ with
+    the samples (in both directions); the conservative regions close them."""
+    kw = {"theta": 0.0, "timeout": None, "conservative": True}
+    out = {"swept": partial_region(scene, target_in="goal", **kw)}
+    if scene.goal_geom.geom_type == "Polygon" or scene.failure_geom.geom_type == "Polygon":
+        out["recognizable"] = recognizable_region(scene, model="partial", **kw)
+    return out
+
+
+def _depth(a: shapely.Geometry, b: shapely.Geometry) -> float:
+    """How far the part of ``a`` outside ``b`` reaches from ``b`` (its vertices' distance)."""
+    pts = shapely.get_coordinates(a.difference(b))
+    return float(shapely.distance(b, shapely.points(pts)).max()) if len(pts) else 0.0
+
+
+def _run(name: str, monkeypatch, lazy: bool) -> tuple[dict, list]:
+    """The regions with lazy (or eager) event sampling, and the Sweepers that made them."""
+    made: list[S.Sweeper] = []
+    orig = S.Sweeper.__post_init__
+
+    def post_init(self) -> None:
+        orig(self)
+        self.lazy_events = lazy
+        made.append(self)
+
+    with monkeypatch.context() as m:
+        m.setattr(S.Sweeper, "__post_init__", post_init)
+        return _queries(_scene(name)), made
+
+
+@pytest.mark.parametrize("name", SCENES)
+def test_lazy_event_samples_give_the_regions_of_sampling_every_event(name, monkeypatch) -> None:
+    lazy, sw_lazy = _run(name, monkeypatch, lazy=True)
+    eager, sw_eager = _run(name, monkeypatch, lazy=False)
+    tol = 1e-4 * _scene(name).diameter  # the queries' default tol (traced chords)
+    for q in eager:
+        # the traces' chords differ with the samples (within tol), and a shadow sliver
+        # that one set of samples leaves and the other does not is grown to a strip tol
+        # wide; a missed wedge is deeper (the fuzz findings the event samples fixed were
+        # 0.009 D = 90 tol deep)
+        deep = max(_depth(lazy[q], eager[q]), _depth(eager[q], lazy[q]))
+        assert deep <= 2 * tol, f"{name} {q}: lazy and eager regions differ by {deep:.3g}"
+    n_lazy = sum(len(sw._frames) for sw in sw_lazy)
+    n_eager = sum(len(sw._frames) for sw in sw_eager)
+    assert n_lazy <= n_eager
+    if name == "real/heidelberg_l2":  # most of its events carry no shadow edge
+        assert n_lazy < 0.5 * n_eager
+
+
+@pytest.mark.parametrize("name", SCENES)
+def test_every_event_names_anchors_collinear_at_its_time(name, monkeypatch) -> None:
+    _, made = _run(name, monkeypatch, lazy=True)
+    checked = 0
+    for sw in made:
+        for q0, q1 in zip(list(sw._frames)[:-1], list(sw._frames)[1:], strict=True):
+            q0, q1 = np.asarray(q0), np.asarray(q1)
+            ts, ids = sw._events(q0, q1 - q0)
+            assert len(ts) == len(ids)
+            assert np.all(np.diff(ts) > 0) and np.all((ts > 0) & (ts < 1))
+            for t, evs in zip(ts, ids, strict=True):
+                assert evs
+                for mov, other in evs:
+                    every = np.array([*mov, *other])
+                    assert len(every) == 3 and len(mov) in (1, 2)
+                    assert (every >= sw.n_fixed).sum() >= len(mov)
+                    if (every < 0).any():
+                        continue
+                    q = np.repeat((q0 + t * (q1 - q0))[None], 3, axis=0)
+                    # events closer than 1e-9 in time are merged: the first time stands
+                    p = sw.pos(every, q)
+                    if np.abs(p).max() > 1e3 * sw.env.scale:
+                        continue  # the end of a wanted piece on a strip nearly parallel to it
+                    span = np.abs(p - p[0]).max()
+                    cross = S._cross(p[1] - p[0], p[2] - p[0])
+                    assert abs(cross) <= 1e-6 * max(span, 1e-12) * sw.env.scale, (name, t, every)
+                    checked += 1
+    assert checked or name == "lab"
+
+
+def test_the_event_samples_matter_where_a_wedge_opens(monkeypatch) -> None:
+    """Fuzz seed 200326: without the samples next to the events the swept region holds
+    placements a wedge born on an event line blinds (hundreds of tol deep); the lazy rule
+    samples next to the event that opens it (the test above: the regions of sampling every
+    event).  So the comparison above can fail."""
+    name = "fuzz:200326"
+    eager, _ = _run(name, monkeypatch, lazy=False)
+    with monkeypatch.context() as m:
+        m.setattr(S.Sweeper, "_live_mids", lambda self, *a: [])
+        none, _ = _run(name, monkeypatch, lazy=True)
+    tol = 1e-4 * _scene(name).diameter
+    assert _depth(none["swept"], eager["swept"]) > 100 * tol
