@@ -1,8 +1,9 @@
 """The region queries on the bundled real maps (public ROS and OpenStreetMap floor plans),
 with an anchor.
 
-    python -m benchmarks.real_maps              # about a minute
+    python -m benchmarks.real_maps              # about six minutes
     python -m benchmarks.real_maps --reps 7
+    python -m benchmarks.real_maps --no-slow    # the real maps only, about a minute
 
 For every scene of ``sensorplan_gym/scenes/real/`` (written by
 :mod:`benchmarks.make_real_maps` from the Willow Garage and LSE arena occupancy maps, and by
@@ -12,79 +13,150 @@ builds its per-scene structures), median over ``--reps`` calls after one warm-up
 
 * ``complete_region`` and ``partial_region`` of the stationary target at G's
   representative point, orientation 0;
-* ``partial_region(target_in="goal")`` (the swept partial query, paper 3.2.2-3.2.3);
+* ``partial_region(target_in="goal")`` (the swept partial query, paper 3.2.2-3.2.3), and the
+  same with every collinearity event sampled (the rule before issue 25's lazy one: the
+  previous implementation, as an anchor);
 * ``recognizable_region(model="partial")`` (5.2: both sweeps, G and H polygons, with the
   overlap strips);
 * ``recognizable_region(model="complete")``;
 
-and gives the ratios swept partial / stationary partial and recognizable (partial) /
-stationary partial, the areas of the answers (all non-empty), and, in the same run on the
-same scenes, the anchor: one CGAL visibility polygon (pyvispoly) at each of 20 free points,
-median per point (see :mod:`benchmarks.scaling`).  Data (``real_maps.json``) and fragment
-(``real_maps.md``) go to ``--out`` (default ``runs/benchmarks/real_maps/``) or, with
-``--update-results``, to ``benchmarks/results/`` and ``docs/results/``.
+then the same on the independent fuzzer's slow reproductions (``slow_1``, ``slow_2``: issue
+25 item 7, their own regions and orientation), and gives the ratios swept partial /
+stationary partial and recognizable (partial) / stationary partial, the areas of the answers
+(all non-empty), and, in the same run on the same scenes, the anchor: one CGAL visibility
+polygon (pyvispoly) at each of 20 free points, median per point (see
+:mod:`benchmarks.scaling`). Data (``real_maps.json``) and fragment (``real_maps.md``) go to
+``--out`` (default ``runs/benchmarks/real_maps/``) or, with ``--update-results``, to
+``benchmarks/results/`` and ``docs/results/``.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import statistics
 import time
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 from geometry import Scene, complete_region, partial_region, recognizable_region
+from geometry.sweep import Sweeper
 from sensorplan_gym.core.scenes import REAL_SCENES, load_scene, real_scene_provenance
 
 from . import _results
 from .scaling import _anchor
 
+#: The independent fuzzer's slow swept queries (issue 25 item 7; ``tests/geometry/fuzz_repro/``,
+#: copies of ``shared/fuzz-repro/``): scene JSON plus the call that took 6.6-10.7 s.
+SLOW_REPROS = ("slow_1", "slow_2")
 
-def _pose(s: Scene) -> tuple[float, float, float]:
+REPRO_DIR = Path(__file__).resolve().parents[1] / "tests" / "geometry" / "fuzz_repro"
+
+
+def _pose(s: Scene, theta: float) -> tuple[float, float, float]:
     c = s.goal_geom.representative_point()
-    return (c.x, c.y, 0.0)
+    return (c.x, c.y, theta)
 
 
-QUERIES: list[tuple[str, Callable[[Scene], Any]]] = [
-    ("complete, stationary", lambda s: complete_region(s, target_at=_pose(s))),
-    ("partial, stationary", lambda s: partial_region(s, target_at=_pose(s))),
-    ("partial, swept over G", lambda s: partial_region(s, target_in="goal", theta=0.0)),
-    ("recognizable, partial", lambda s: recognizable_region(s, model="partial", theta=0.0)),
-    ("recognizable, complete", lambda s: recognizable_region(s, model="complete", theta=0.0)),
-]
+def queries(theta: float) -> list[tuple[str, Callable[[Scene], Any]]]:
+    """The timed queries, the target at orientation ``theta`` (radians)."""
+    return [
+        ("complete, stationary", lambda s: complete_region(s, target_at=_pose(s, theta))),
+        ("partial, stationary", lambda s: partial_region(s, target_at=_pose(s, theta))),
+        ("partial, swept over G", lambda s: partial_region(s, target_in="goal", theta=theta)),
+        (
+            "swept, every event sampled",
+            lambda s: _eager(lambda: partial_region(s, target_in="goal", theta=theta)),
+        ),
+        (
+            "recognizable, partial",
+            lambda s: recognizable_region(s, model="partial", theta=theta),
+        ),
+        (
+            "recognizable, complete",
+            lambda s: recognizable_region(s, model="complete", theta=theta),
+        ),
+    ]
 
 
-def _time_fresh(fn: Callable[[Scene], Any], name: str, reps: int) -> tuple[float, float]:
+QUERIES = queries(0.0)
+
+
+def _eager(fn: Callable[[], Any]) -> Any:
+    """``fn()`` with the sweep sampling next to every collinearity event (the rule before
+    the lazy one, :attr:`geometry.sweep.Sweeper.lazy_events`): the previous implementation
+    as the anchor of the swept query, in the same run."""
+    orig = Sweeper.__post_init__
+
+    def eager_init(self: Sweeper) -> None:
+        orig(self)
+        self.lazy_events = False
+
+    Sweeper.__post_init__ = eager_init  # type: ignore[method-assign]
+    try:
+        return fn()
+    finally:
+        Sweeper.__post_init__ = orig  # type: ignore[method-assign]
+
+
+def _repro(name: str) -> tuple[dict, float]:
+    """The scene dictionary of a slow reproduction and the orientation of its call."""
+    d = json.loads((REPRO_DIR / f"{name}.json").read_text(encoding="utf-8"))
+    call = d["call"]
+    theta = float(call.split("'theta': ")[1].split("}")[0].split(",")[0])
+    return d["scene"], theta
+
+
+def _time_fresh(fn: Callable[[Scene], Any], load: Callable[[], Scene], reps: int) -> tuple:
     """Median seconds of ``fn`` on a freshly loaded scene (``reps`` calls after a warm-up)
     and the area of its answer."""
-    area = fn(load_scene(name)).area
+    area = fn(load()).area
     times = []
     for _ in range(reps):
-        s = load_scene(name)
+        s = load()
         t0 = time.perf_counter()
         fn(s)
         times.append(time.perf_counter() - t0)
     return statistics.median(times), float(area)
 
 
-def run(reps: int) -> dict[str, Any]:
-    """Time every query on every real scene; seconds and square metres."""
+def _cases() -> list[tuple[str, str, Callable[[], Scene], float]]:
+    """(name, source, loader, theta) of every timed scene: the bundled real maps, then the
+    fuzzer's slow reproductions."""
     prov = real_scene_provenance()
-    rows = []
+    out = []
     for real in REAL_SCENES:
         name = real.removeprefix("real/")
-        s = load_scene(real)
+        src = f"{prov[name]['repository']} {prov[name]['path']}"
+        out.append((name, src, lambda real=real: load_scene(real), 0.0))
+    for name in SLOW_REPROS:
+        d, theta = _repro(name)
+        src = f"tests/geometry/fuzz_repro/{name}.json (independent fuzzer, issue 25)"
+        out.append((name, src, lambda d=d: Scene.from_dict(d), theta))
+    return out
+
+
+def run(reps: int, slow: bool = True) -> dict[str, Any]:
+    """Time every query on every real scene (and, with ``slow``, the fuzzer's slow
+    reproductions); seconds and square metres."""
+    rows = []
+    for name, src, load, theta in _cases():
+        if not slow and name in SLOW_REPROS:
+            continue
+        s = load()
         edges = len(s.bounds) + sum(len(o) for o in s.obstacles)
         row: dict[str, Any] = {
             "scene": name,
             "edges": edges,
-            "source": f"{prov[name]['repository']} {prov[name]['path']}",
+            "source": src,
+            "theta": theta,
             "anchor_s": _anchor(s),
             "query_s": {},
             "area_m2": {},
         }
-        for qname, fn in QUERIES:
-            t, a = _time_fresh(fn, real, reps)
+        for qname, fn in queries(theta):
+            t, a = _time_fresh(fn, load, reps)
             row["query_s"][qname] = t
             row["area_m2"][qname] = a
             print(f"  {name:>14} edges={edges:4d} {qname:24s} {1e3 * t:9.1f} ms  {a:8.2f} m2")
@@ -121,8 +193,17 @@ def render(data: dict[str, Any]) -> str:
     lines += [
         "",
         f"`{data['command']}`: median of {data['reps']} calls, each on a freshly loaded scene "
-        "(after one warm-up call); G and H regular pentagons; anchor = median CGAL visibility "
-        "polygon (pyvispoly) at 20 free points of the same scene, same run; "
+        "(after one warm-up call); G and H regular pentagons on the real maps; "
+        "anchor = median CGAL visibility polygon (pyvispoly) at 20 free points of the same "
+        "scene, same run; "
+        '"swept, every event sampled": the swept query with the collinearity events sampled '
+        "as before issue 25's lazy rule (`Sweeper.lazy_events=False`), the previous "
+        "implementation as an anchor; `slow_1`, `slow_2`: the independent fuzzer's slow "
+        "reproductions (issue 25 item 7; their own G, H, target and orientation: "
+        + "; ".join(
+            f"{r['scene']} theta = {r['theta']:.3f}" for r in data["rows"] if "fuzz" in r["source"]
+        )
+        + "); "
         f"{m['cpus']} CPUs, Python {m['python']}, load average {m['load_average']}.",
     ]
     return "\n".join(lines) + "\n"
@@ -133,12 +214,15 @@ def main(argv: list[str] | None = None) -> None:
         prog="python -m benchmarks.real_maps", description=__doc__.split("\n\n")[0]
     )
     ap.add_argument("--reps", type=int, default=5)
+    ap.add_argument(
+        "--no-slow", action="store_true", help="leave out the fuzzer's slow reproductions"
+    )
     _results.add_output_args(ap, "real_maps")
     args = ap.parse_args(argv)
     data = {
         "command": _results.command("benchmarks.real_maps", argv),
         "machine": _results.machine(),
-        **run(args.reps),
+        **run(args.reps, slow=not args.no_slow),
     }
     print(render(data))
     _results.write("real_maps", data, args.out, args.update_results)

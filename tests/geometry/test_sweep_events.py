@@ -33,6 +33,7 @@ SCENES = [
     "lab",
     "real/heidelberg_l2",
     "fuzz:200326",
+    "fuzz:200007",
 ]
 
 
@@ -128,15 +129,17 @@ def test_every_event_names_anchors_collinear_at_its_time(name, monkeypatch) -> N
     assert checked or name == "lab"
 
 
-def test_the_event_samples_matter_where_a_wedge_opens(monkeypatch) -> None:
-    """Fuzz seed 200326: without the samples next to the events the swept region holds
-    placements a wedge born on an event line blinds (hundreds of tol deep); the lazy rule
-    samples next to the event that opens it (the test above: the regions of sampling every
-    event).  So the comparison above can fail."""
-    name = "fuzz:200326"
+@pytest.mark.parametrize(
+    ("name", "query", "deeper"), [("fuzz:200326", "swept", 100), ("fuzz:200007", "recognizable", 3)]
+)
+def test_the_event_samples_matter_where_a_wedge_opens(name, query, deeper, monkeypatch) -> None:
+    """Fuzz seeds 200326 (3.2.2) and 200007 (5.2): without the samples next to the events the
+    region holds placements that a wedge born on an event line blinds (337 and 6 tol deep);
+    the lazy rule samples next to the event that opens it (the test above compares it with
+    sampling every event on these scenes).  So that comparison can fail."""
     eager, _ = _run(name, monkeypatch, lazy=False)
     with monkeypatch.context() as m:
         m.setattr(S.Sweeper, "_live_mids", lambda self, *a: [])
         none, _ = _run(name, monkeypatch, lazy=True)
     tol = 1e-4 * _scene(name).diameter
-    assert _depth(none["swept"], eager["swept"]) > 100 * tol
+    assert _depth(none[query], eager[query]) > deeper * tol
