@@ -152,8 +152,10 @@ class Sweeper:
     bisect_steps: int = 14
     probes: int = 4
     #: sample only next to the collinearity events whose wedge lines carry a shadow edge
-    #: (:meth:`_live_mids`); False: next to every event (the reference the tests compare with)
-    lazy_events: bool = True
+    #: (:meth:`_live_mids`), and bisect for births only where an eroded target exists within
+    #: the depth limit (:meth:`_core_within_depth`); False: next to every event and on every
+    #: empty eroded target (the previous rules, the reference the tests compare with)
+    lazy_samples: bool = True
     #: ``time.monotonic()`` value after which the sweep stops (None: no limit).
     deadline: float | None = None
     _cut_segs: np.ndarray = field(init=False, repr=False)
@@ -697,7 +699,7 @@ class Sweeper:
         An event (index into ``ev_t``) is *live* when a shadow edge at a sample so far
         (``frames``: time -> (shadow, edges); the edge or one of its neighbours) lies on a
         line spanned by two of its anchors, one of them moving (:meth:`_events`' ids; an
-        unknown id, -1, makes it live; ``lazy_events=False``: every event is).  The wedge
+        unknown id, -1, makes it live; ``lazy_samples=False``: every event is).  The wedge
         that opens at an event grows from a line that continues an edge of an existing
         shadow, and that edge lies on such a line, so an event none of whose lines
         carries a shadow edge at any sample opens no wedge *unless* that edge itself is
@@ -712,7 +714,7 @@ class Sweeper:
         for k in range(len(ev_t)):
             if k in looked:
                 continue
-            live = not self.lazy_events
+            live = not self.lazy_samples
             for mov, other in ev_ids[k]:
                 if -1 in mov or -1 in other:
                     live = True
@@ -1177,7 +1179,9 @@ class Sweeper:
     def _refine_births(self, ts: list, q0, dq, frame, stats) -> list:
         """Add sample times where the eroded target's shadow has a component that
         neither neighbouring sample's shadow meets (a shadow born and dying in
-        between); bisect up to ``max_depth`` times.  With overlap strips (5.2) the eroded
+        between); bisect up to ``max_depth`` times, and on an interval without an eroded
+        target only where one exists within that limit (:meth:`_core_within_depth`).  With
+        overlap strips (5.2) the eroded
         target's whole outline counts as wanted: its shadow bounds the full target's
         shadows, which the 5.2 shadows contain, so a shadow of the full target born in
         between is caught here too (and the 5.2 region stays inside R(G); fuzz seed 411063,
@@ -1197,7 +1201,8 @@ class Sweeper:
                 self._check_time()
                 upper = self._eroded_shadow(q0 + a * dq, q0 + b * dq)
                 if upper is None:
-                    new = True
+                    # no eroded target: bisect where one exists within the depth limit
+                    new = self._core_within_depth(b - a, depth, dq)
                 else:
                     parts = shapely.get_parts(upper)
                     parts = parts[~shapely.is_empty(parts)]  # an empty shadow: no new component
@@ -1215,6 +1220,20 @@ class Sweeper:
                 stats["refined"] += 1
                 todo += [(a, m, depth + 1), (m, b, depth + 1)]
         return sorted(out)
+
+    def _core_within_depth(self, span: float, depth: int, dq: np.ndarray) -> bool:
+        """Whether the target has a non-empty eroded part (:meth:`_eroded_core`) over the
+        shortest interval the birth check still examines below an interval ``span`` long (in
+        t) at ``depth``: ``span / 2**(max_depth - 1 - depth)`` (the check looks at depths
+        below ``max_depth``).  Where it has none even there (a sliver moving across its own
+        thickness), bisecting cannot give the check an upper bound to test with, only
+        samples.  Always True with ``lazy_samples=False`` (the previous rule)."""
+        if not self.lazy_samples:
+            return True
+        if depth >= self.max_depth - 1:
+            return False
+        step = math.ldexp(span, depth + 1 - self.max_depth)
+        return self._eroded_core(np.zeros(2), step * dq) is not None
 
     def _eroded_shadow(self, qa: np.ndarray, qb: np.ndarray) -> shapely.Geometry | None:
         """Shadow of the part of A common to all A_q, q in [qa, qb] (it contains

@@ -16,6 +16,7 @@ import shapely
 
 from geometry import Scene, partial_region, recognizable_region
 from geometry import sweep as S
+from geometry._common import scene_domain
 from geometry.fuzz import fuzz_scene
 from sensorplan_gym.core.scenes import load_scene
 
@@ -65,19 +66,25 @@ def _depth(a: shapely.Geometry, b: shapely.Geometry) -> float:
     return float(shapely.distance(b, shapely.points(pts)).max()) if len(pts) else 0.0
 
 
-def _run(name: str, monkeypatch, lazy: bool) -> tuple[dict, list]:
-    """The regions with lazy (or eager) event sampling, and the Sweepers that made them."""
+def _with_rule(lazy: bool, fn, monkeypatch):
+    """``fn()`` with the lazy (or the previous, eager) sampling rules, and the Sweepers it
+    made."""
     made: list[S.Sweeper] = []
     orig = S.Sweeper.__post_init__
 
     def post_init(self) -> None:
         orig(self)
-        self.lazy_events = lazy
+        self.lazy_samples = lazy
         made.append(self)
 
     with monkeypatch.context() as m:
         m.setattr(S.Sweeper, "__post_init__", post_init)
-        return _queries(_scene(name)), made
+        return fn(), made
+
+
+def _run(name: str, monkeypatch, lazy: bool) -> tuple[dict, list]:
+    """The regions with lazy (or eager) sampling, and the Sweepers that made them."""
+    return _with_rule(lazy, lambda: _queries(_scene(name)), monkeypatch)
 
 
 @pytest.mark.parametrize("name", SCENES)
@@ -143,3 +150,38 @@ def test_the_event_samples_matter_where_a_wedge_opens(name, query, deeper, monke
         none, _ = _run(name, monkeypatch, lazy=True)
     tol = 1e-4 * _scene(name).diameter
     assert _depth(none[query], eager[query]) > deeper * tol
+
+
+def test_the_birth_check_bisects_only_where_an_eroded_target_can_exist() -> None:
+    """A target that moves across its own thickness has no eroded part on any interval the
+    check may reach: the sliver of ``slow_1`` (0.81 x 0.001) moving 0.5 across gets no
+    bisection from an empty eroded target; a square moving as far does (its eroded part
+    exists once the interval is short enough), and so does the sliver moving along itself."""
+    sliver = np.array([[-0.4, -0.0005], [0.4, -0.0005], [0.4, 0.0005], [-0.4, 0.0005]])
+    square = np.array([[-0.1, -0.1], [0.1, -0.1], [0.1, 0.1], [-0.1, 0.1]])
+    scene = Scene.load("sensorplan_gym/scenes/lab.json")
+    for ring, dq, want in (
+        (sliver, np.array([0.0, 0.5]), False),
+        (square, np.array([0.0, 0.5]), True),
+        (sliver, np.array([0.5, 0.0]), True),
+    ):
+        sw = S.Sweeper(scene_domain(scene), scene.free_space, ring, ring, None, 0.0, 1e-3)
+        assert sw._core_within_depth(1.0, 0, dq) is want
+        sw.lazy_samples = False  # the previous rule: bisect on every empty eroded target
+        assert sw._core_within_depth(1.0, 0, dq) is True
+
+
+def test_a_sliver_sweep_is_the_eager_one_with_fewer_samples(monkeypatch) -> None:
+    """``slow_1`` (the independent fuzzer's slow swept query, a sliver target): the lazy rules
+    take a fraction of the samples and give the conservative region of the previous rules."""
+    d = json.loads((REPRO / "slow_1.json").read_text())
+    kw = {"target_in": "goal", "theta": 0.6831449051177683, "conservative": True}
+    got = {}
+    for lazy in (True, False):
+        region, made = _with_rule(
+            lazy, lambda: partial_region(Scene.from_dict(d["scene"]), **kw), monkeypatch
+        )
+        got[lazy] = (region, len(made[0]._frames))
+    tol = 1e-4 * Scene.from_dict(d["scene"]).diameter
+    assert max(_depth(got[True][0], got[False][0]), _depth(got[False][0], got[True][0])) <= 2 * tol
+    assert got[True][1] < 0.6 * got[False][1]
