@@ -105,7 +105,9 @@ def render(data: dict[str, Any]) -> str:
         "",
         "Areas as fractions of D², distances of D (D the scene's diameter); upper Hausdorff "
         "bounds (`hausdorff_bounds`). *outer* ⊇ the exact answer and *proven inner* ⊆ it are "
-        "proven; *inner* is the `conservative=True` answer (checked, not proven). `swept`: "
+        "proven; *inner* is the `conservative=True` answer with the sweep's previous, denser "
+        "sampling rules, which `swept_bounds` takes (checked, not proven; within 2 `tol` of "
+        "the default lazy answer). `swept`: "
         '`partial_region(target_in="goal")`; `5.2`: `recognizable_region(model="partial")`. '
         f"`densify={data['densify']}`.",
         "",

@@ -14,8 +14,8 @@ builds its per-scene structures), median over ``--reps`` calls after one warm-up
 * ``complete_region`` and ``partial_region`` of the stationary target at G's
   representative point, orientation 0;
 * ``partial_region(target_in="goal")`` (the swept partial query, paper 3.2.2-3.2.3), and the
-  same with every collinearity event sampled (the rule before issue 25's lazy one: the
-  previous implementation, as an anchor);
+  same with the sampling rules before issue 25's lazy ones (next to every collinearity
+  event, bisecting every empty eroded target: the previous implementation, as an anchor);
 * ``recognizable_region(model="partial")`` (5.2: both sweeps, G and H polygons, with the
   overlap strips);
 * ``recognizable_region(model="complete")``;
@@ -41,11 +41,11 @@ from pathlib import Path
 from typing import Any
 
 from geometry import Scene, complete_region, partial_region, recognizable_region
-from geometry.sweep import Sweeper
 from sensorplan_gym.core.scenes import REAL_SCENES, load_scene, real_scene_provenance
 
 from . import _results
 from .scaling import _anchor
+from .swept import _eager
 
 #: The independent fuzzer's slow swept queries (issue 25 item 7; ``tests/geometry/fuzz_repro/``,
 #: copies of ``shared/fuzz-repro/``): scene JSON plus the call that took 6.6-10.7 s.
@@ -66,7 +66,7 @@ def queries(theta: float) -> list[tuple[str, Callable[[Scene], Any]]]:
         ("partial, stationary", lambda s: partial_region(s, target_at=_pose(s, theta))),
         ("partial, swept over G", lambda s: partial_region(s, target_in="goal", theta=theta)),
         (
-            "swept, every event sampled",
+            "swept, previous rules",
             lambda s: _eager(lambda: partial_region(s, target_in="goal", theta=theta)),
         ),
         (
@@ -81,23 +81,6 @@ def queries(theta: float) -> list[tuple[str, Callable[[Scene], Any]]]:
 
 
 QUERIES = queries(0.0)
-
-
-def _eager(fn: Callable[[], Any]) -> Any:
-    """``fn()`` with the sweep sampling next to every collinearity event (the rule before
-    the lazy one, :attr:`geometry.sweep.Sweeper.lazy_events`): the previous implementation
-    as the anchor of the swept query, in the same run."""
-    orig = Sweeper.__post_init__
-
-    def eager_init(self: Sweeper) -> None:
-        orig(self)
-        self.lazy_events = False
-
-    Sweeper.__post_init__ = eager_init  # type: ignore[method-assign]
-    try:
-        return fn()
-    finally:
-        Sweeper.__post_init__ = orig  # type: ignore[method-assign]
 
 
 def _repro(name: str) -> tuple[dict, float]:
@@ -196,9 +179,10 @@ def render(data: dict[str, Any]) -> str:
         "(after one warm-up call); G and H regular pentagons on the real maps; "
         "anchor = median CGAL visibility polygon (pyvispoly) at 20 free points of the same "
         "scene, same run; "
-        '"swept, every event sampled": the swept query with the collinearity events sampled '
-        "as before issue 25's lazy rule (`Sweeper.lazy_events=False`), the previous "
-        "implementation as an anchor; `slow_1`, `slow_2`: the independent fuzzer's slow "
+        '"swept, previous rules": the swept query sampled as before issue 25\'s lazy rules '
+        "(next to every collinearity event, bisecting every empty eroded target: "
+        "`geometry.sweep.LAZY_SAMPLES = False`), the previous implementation as an anchor; "
+        "`slow_1`, `slow_2`: the independent fuzzer's slow "
         "reproductions (issue 25 item 7; their own G, H, target and orientation: "
         + "; ".join(
             f"{r['scene']} theta = {r['theta']:.3f}" for r in data["rows"] if "fuzz" in r["source"]

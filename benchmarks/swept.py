@@ -3,15 +3,15 @@
 Run ``python -m benchmarks.swept`` (``--quick``: one repetition, fewer sizes).
 
 For generated scenes with about 25, 50 and 100 environment edges
-(:func:`geometry.generate.scene_with_edges`) the goal G is replaced by a regular
-k-gon (k = 4, 5, 6, 8) inside it, and H likewise by a k-gon inside H, so that the
-growth with the edges of G can be read off.  Times
-``partial_region(target_in="goal", theta=0.3)`` and
-``recognizable_region(model="partial", theta=0.3)`` (both sweeps, G and H, with
-the overlap strips of 5.2); median and IQR over the repetitions, each on a
-freshly loaded Scene.  The data (``swept.json``) and the page fragment (``swept.md``) go to
-``--out`` (default ``runs/benchmarks/swept/``), or with ``--update-results`` to the tracked
-``benchmarks/results/swept.json`` and ``docs/results/swept.md``.
+(:func:`geometry.generate.scene_with_edges`) the goal G is replaced by a regular k-gon (k =
+4, 5, 6, 8) inside it, and H likewise by a k-gon inside H, so that the growth with the edges
+of G can be read off. Times ``partial_region(target_in="goal", theta=0.3)`` and
+``recognizable_region(model="partial", theta=0.3)`` (both sweeps, G and H, with the overlap
+strips of 5.2); median and IQR over the repetitions, each on a freshly loaded Scene, and the
+same with the previous sampling rules (the anchor). The data (``swept.json``) and the page
+fragment (``swept.md``) go to ``--out`` (default ``runs/benchmarks/swept/``), or with
+``--update-results`` to the tracked ``benchmarks/results/swept.json`` and
+``docs/results/swept.md``.
 """
 
 from __future__ import annotations
@@ -20,15 +20,29 @@ import argparse
 import math
 import statistics
 import time
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 import shapely
 
 from geometry import Scene, partial_region, recognizable_region
+from geometry import sweep as _sweep
 from geometry.generate import scene_with_edges
 
 from . import _results
+
+
+def _eager(fn: Callable[[], Any]) -> Any:
+    """``fn()`` with the sweep's previous sampling rules (next to every collinearity event,
+    bisecting every empty eroded target: ``geometry.sweep.LAZY_SAMPLES`` False): the
+    previous implementation as the anchor of the swept query, in the same run."""
+    before = _sweep.LAZY_SAMPLES
+    _sweep.LAZY_SAMPLES = False
+    try:
+        return fn()
+    finally:
+        _sweep.LAZY_SAMPLES = before
 
 
 def _kgon(poly: list, k: int) -> list[list[float]]:
@@ -81,15 +95,24 @@ def main(argv: list[str] | None = None) -> None:
         "reps": reps,
         "rows": [],
     }
+    queries[0][1](Scene.from_dict(_scene(sizes[0], ks[0])))  # one-time costs (kernels)
     for name, fn in queries:
         for n in sizes:
             for k in ks:
                 d = _scene(n, k)
                 med, iqr = _time(fn, d, reps)
+                prev, _ = _time(lambda s, fn=fn: _eager(lambda: fn(s)), d, reps)
                 data["rows"].append(
-                    {"query": name, "edges": n, "k": k, "median_s": med, "iqr_s": iqr}
+                    {
+                        "query": name,
+                        "edges": n,
+                        "k": k,
+                        "median_s": med,
+                        "iqr_s": iqr,
+                        "previous_s": prev,
+                    }
                 )
-                print(f"| {name} | {n} | {k} | {med:.2f} | {iqr:.2f} |", flush=True)
+                print(f"| {name} | {n} | {k} | {med:.2f} | {iqr:.2f} | {prev:.2f} |", flush=True)
     _results.write("swept", data, args.out, args.update_results)
 
 
@@ -109,15 +132,20 @@ def render(data: dict[str, Any]) -> str:
         cells = []
         for n in sizes:
             m = [r for r in data["rows"] if (r["query"], r["k"], r["edges"]) == (q, k, n)]
-            cells.append(f"{m[0]['median_s']:.2f} s" if m else "")
+            prev = m[0].get("previous_s") if m else None
+            cell = f"{m[0]['median_s']:.2f} s" if m else ""
+            cells.append(cell + (f" ({prev:.2f} s)" if prev is not None else ""))
         label = f"`{q}`" if q != last else ""
         last = q
         lines.append(f"| {label} | {k} | " + " | ".join(cells) + " |")
     m = data["machine"]
     lines += [
         "",
-        f"`{data['command']}`: median of {data['reps']} calls, each on a freshly loaded scene; "
-        f"{m['cpus']} CPUs, Python {m['python']}, load average {m['load_average']}.",
+        f"`{data['command']}`: median of {data['reps']} calls, each on a freshly loaded scene "
+        "(after one call that pays the one-time costs); in parentheses the same with the "
+        "previous sampling rules (`geometry.sweep.LAZY_SAMPLES = False`), "
+        f"the anchor, in the same run; {m['cpus']} CPUs, Python {m['python']}, "
+        f"load average {m['load_average']}.",
     ]
     return "\n".join(lines) + "\n"
 

@@ -9,10 +9,11 @@ Swept queries: :func:`geometry.partial_region` with ``target_in=`` (paper 3.2.2)
 
 S(q) the stationary shadow (placements blind to every wanted point of A_q).
 
-* ``inner`` is what ``conservative=True`` returns: the traced shadow union grown by
-  ``tol + grid``.  ``inner`` is inside E *as long as the sweep misses no shadow
-  deeper than tol* (docs/DESIGN.md, "What is and is not guaranteed": not proven;
-  checked empirically, ``tests/geometry/test_swept_bounds.py``).
+* ``inner`` is what ``conservative=True`` returns with the sweep's previous, denser
+  sampling rules (:data:`geometry.sweep.LAZY_SAMPLES` False; within 2 tol of the lazy
+  answer): the traced shadow union grown by ``tol + grid``.  ``inner`` is inside E *as
+  long as the sweep misses no shadow deeper than tol* (docs/DESIGN.md, "What is and is
+  not guaranteed": not proven; checked empirically, ``tests/geometry/test_swept_bounds.py``).
 * ``outer`` is ``allowed`` minus the union of the *sampled* stationary shadows S(q_k)
   (q_k on the boundary of G, so in G).  Each S(q_k) is an exact stationary shadow, so
   it is a subset of the exact union and ``E ⊆ outer``.  This needs no claim about the
@@ -190,7 +191,7 @@ def _side(
     sink: dict = {}
     inner = _swept_region(
         scene, target_in, theta, eps_pos, eps_aim, tol, True, strips=strips, budget=budget,
-        sink=sink, extra_samples=densify,
+        sink=sink, extra_samples=densify, lazy=False,
     )  # fmt: skip
     samples = sink["samples"]
     stand_in = sink["stand_in"]

@@ -29,6 +29,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import shapely
 
+from . import sweep as _sweep
 from ._common import (
     Budget,
     as_scene,
@@ -193,10 +194,12 @@ def _swept_region(
     budget: Budget | None = None,
     sink: dict | None = None,
     extra_samples: int = 0,
+    lazy: bool | None = None,
 ) -> shapely.Geometry:
     """The partial region of a target translating through ``target_in``.  ``sink``: a
     dict that receives the sampled exact shadows and the pieces of the answer
-    (:mod:`geometry.certify`)."""
+    (:mod:`geometry.certify`); ``lazy``: the sweep's sampling rules
+    (:attr:`geometry.sweep.Sweeper.lazy_samples`; None: :data:`geometry.sweep.LAZY_SAMPLES`)."""
     budget = budget or Budget()
     if theta is None:
         raise NotImplementedError(ROTATING_PARTIAL)
@@ -209,8 +212,9 @@ def _swept_region(
     stand_in = None if is_star_shaped(target) else hull_target(target, strips, region)
     if stand_in is not None:
         target, strips = stand_in.ring, stand_in.strips
+    lazy = _sweep.LAZY_SAMPLES if lazy is None else lazy
     reuse = sink is None and extra_samples == 0 and budget.progress is None
-    key = _sweep_key(scene, target, region, strips, eps_aim, tol) if reuse else None
+    key = _sweep_key(scene, target, region, strips, eps_aim, tol) + (lazy,) if reuse else None
     got = _SWEEPS.get(key) if key is not None else None
     if got is not None and got[0]() is scene:
         _SWEEPS.move_to_end(key)
@@ -229,6 +233,7 @@ def _swept_region(
             what=budget.what,
             samples=None if sink is None else sink.setdefault("samples", []),
             extra_samples=extra_samples,
+            lazy=lazy,
         )
         if key is not None:
             _SWEEPS[key] = (weakref.ref(scene), (shadows, stats))

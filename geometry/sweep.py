@@ -89,6 +89,11 @@ CUT_REL = 1e-3
 #: tree of midpoints in one batch: see :meth:`Sweeper._bisect`.
 BISECT_LEVELS = 3
 
+#: The sampling rules of the sweeps (:attr:`Sweeper.lazy_samples`) when the caller does not
+#: choose: True, the lazy ones; False, the previous, denser ones (the reference the tests and
+#: benchmarks compare with; :mod:`geometry.certify` always takes those).
+LAZY_SAMPLES = True
+
 __all__ = ["QueryTimeout", "Sweeper", "star_center", "swept_shadows"]
 
 
@@ -699,7 +704,8 @@ class Sweeper:
         An event (index into ``ev_t``) is *live* when a shadow edge at a sample so far
         (``frames``: time -> (shadow, edges); the edge or one of its neighbours) lies on a
         line spanned by two of its anchors, one of them moving (:meth:`_events`' ids; an
-        unknown id, -1, makes it live; ``lazy_samples=False``: every event is).  The wedge
+        unknown id, -1, makes it live; ``lazy_samples=False``: the previous rule, the
+        midpoint of every interval between events, 0.5 on an edge without events).  The wedge
         that opens at an event grows from a line that continues an edge of an existing
         shadow, and that edge lies on such a line, so an event none of whose lines
         carries a shadow edge at any sample opens no wedge *unless* that edge itself is
@@ -707,14 +713,19 @@ class Sweeper:
         docs/DESIGN.md, "Collinearity events").  The caller samples, then asks again (the
         new samples can make more events live); each event is looked at until it is live
         once (``looked``)."""
-        keys = {frozenset(k) for _, es in frames.values() for e in es for k in e}
         bounds = np.concatenate([[0.0], ev_t, [1.0]])
+        if not self.lazy_samples:  # the previous rule: once between every two events, at once
+            if -1 in looked:
+                return []
+            looked.update([-1, *range(len(ev_t))])
+            return sorted({float(t) for t in 0.5 * (bounds[1:] + bounds[:-1])} - set(frames))
+        keys = {frozenset(k) for _, es in frames.values() for e in es for k in e}
         times = np.array(sorted(frames))
         out: set[float] = set()
         for k in range(len(ev_t)):
             if k in looked:
                 continue
-            live = not self.lazy_samples
+            live = False
             for mov, other in ev_ids[k]:
                 if -1 in mov or -1 in other:
                     live = True
@@ -1739,6 +1750,7 @@ def swept_shadows(
     what: str = "the swept query",
     samples: list | None = None,
     extra_samples: int = 0,
+    lazy: bool | None = None,
 ) -> tuple[shapely.Geometry, dict]:
     """Union of the partial-visibility shadows S(q) over the reference points q
     of ``region`` (a Point or Polygon), for the target outline ``target``
@@ -1772,6 +1784,10 @@ def swept_shadows(
     in the caller's frame; used by :mod:`geometry.certify` for the outer bound), and
     for ``extra_samples`` more configurations evenly spaced inside every edge of the
     region's boundary (those shadows are not part of the union returned).
+
+    ``lazy``: the sampling rules of :attr:`Sweeper.lazy_samples` (False: the previous,
+    denser ones; :mod:`geometry.certify` takes those, its outer bound is made of the samples;
+    None: :data:`LAZY_SAMPLES`).
     """
     c = star_center(target)
     if c is None:
@@ -1785,7 +1801,10 @@ def swept_shadows(
         shapely.multipoints((ring0[:, None, :] + _region_pts(region)[None, :, :]).reshape(-1, 2))
     )
     hull_pts = np.asarray(shapely.orient_polygons(hull, exterior_cw=False).exterior.coords)[:-1]
-    sw = Sweeper(env, free, ring0, hull_pts, strips, eps_aim, tol, deadline=deadline)
+    lazy = LAZY_SAMPLES if lazy is None else lazy
+    sw = Sweeper(
+        env, free, ring0, hull_pts, strips, eps_aim, tol, deadline=deadline, lazy_samples=lazy
+    )
     pieces: list[shapely.Geometry] = []
     stats = {"samples": 0, "edges": 0, "refined": 0}
     if region.geom_type == "Point":

@@ -74,12 +74,14 @@ def _with_rule(lazy: bool, fn, monkeypatch):
 
     def post_init(self) -> None:
         orig(self)
-        self.lazy_samples = lazy
         made.append(self)
 
     with monkeypatch.context() as m:
         m.setattr(S.Sweeper, "__post_init__", post_init)
-        return fn(), made
+        m.setattr(S, "LAZY_SAMPLES", lazy)
+        got = fn()
+    assert all(sw.lazy_samples is lazy for sw in made)
+    return got, made
 
 
 def _run(name: str, monkeypatch, lazy: bool) -> tuple[dict, list]:

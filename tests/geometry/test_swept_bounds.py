@@ -9,7 +9,10 @@ bundled scenes:
 * every placement of ``inner`` (farther than 1e-7 D from its boundary) passes;
 * every placement of the allowed space outside ``outer`` (farther than 1e-7 D from
   it) has a witness;
-* ``inner ⊆ outer`` and ``inner`` is the ``conservative=True`` answer.
+* ``inner ⊆ outer`` and ``inner`` is the ``conservative=True`` answer of the sweep with the
+  previous, denser sampling rules (``geometry.sweep.LAZY_SAMPLES = False``: swept_bounds sweeps
+  with those, the outer bound is made of the samples; every test here compares with answers
+  under those rules, and one test bounds how far the lazy answer is from that inner).
 
 The checker is shown to fail on a deliberately wrong outer (the default answer
 eroded) and a deliberately wrong inner (the default answer grown).
@@ -27,7 +30,16 @@ pytest.importorskip("pyvispoly")
 import shapely  # noqa: E402
 
 from geometry import Scene, partial_region, recognizable_region, swept_bounds  # noqa: E402
+from geometry import sweep as _sweep  # noqa: E402
 from geometry.fuzz import fuzz_scene  # noqa: E402
+
+
+@pytest.fixture(autouse=True)
+def _previous_rules(monkeypatch):
+    """The answers compared with the bounds come from the sampling rules swept_bounds uses."""
+    monkeypatch.setattr(_sweep, "LAZY_SAMPLES", False)
+
+
 from geometry.generate import random_scene  # noqa: E402
 
 try:
@@ -506,3 +518,18 @@ def test_a_region_with_a_hole_is_covered_by_cells(monkeypatch):
     D = scene.diameter
     assert b.proven_inner is not None and not b.proven_inner.is_empty
     assert shapely.difference(b.proven_inner, b.outer).area <= 1e-12 * D * D
+
+
+def test_the_lazy_answer_is_within_tol_of_the_certified_inner(monkeypatch):
+    """swept_bounds sweeps with the previous sampling rules; the answer a user gets from
+    ``partial_region(conservative=True)`` (the lazy rules) differs from its inner by at most
+    a couple of tol (the traced chords and the slivers the conservative growth closes)."""
+    scene = Scene.load("sensorplan_gym/scenes/lab.json")
+    b = swept_bounds(scene, target_in="goal", theta=0.0)
+    monkeypatch.setattr(_sweep, "LAZY_SAMPLES", True)
+    lazy = partial_region(scene, target_in="goal", theta=0.0, conservative=True)
+    tol = 1e-4 * scene.diameter
+    for a, c in ((lazy, b.inner), (b.inner, lazy)):
+        pts = shapely.get_coordinates(shapely.difference(a, c))
+        if len(pts):
+            assert shapely.distance(c, shapely.points(pts)).max() <= 2 * tol
