@@ -127,6 +127,41 @@ class _Cover:
     probed: list[tuple] = field(default_factory=list)
 
 
+@dataclass(eq=False)
+class _Run:
+    """One segment ``q0 -> q1`` of a sweep (:meth:`Sweeper.along_many`): its sample times
+    and their frames (time -> (shadow, edges), shared through the sweeper's cache by the
+    segments meeting at a vertex of G), its events (:meth:`Sweeper._events`), the events
+    already found live and its counters."""
+
+    sw: Sweeper
+    q0: np.ndarray
+    q1: np.ndarray
+    frames: dict[float, tuple] = field(default_factory=dict)
+    looked: set[int] = field(default_factory=set)
+    stats: dict[str, int] = field(default_factory=lambda: {"samples": 0, "edges": 0, "refined": 0})
+    ev_t: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    ev_ids: list = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        self.dq = self.q1 - self.q0
+
+    def frame(self, t: float) -> tuple:
+        """(shadow, edges) at time ``t`` (:meth:`Sweeper.shadow`, :meth:`Sweeper._edges`),
+        computed once per configuration."""
+        got = self.frames.get(t)
+        if got is None:
+            sw = self.sw
+            q = self.q1 if t == 1.0 else self.q0 + t * self.dq
+            key = (float(q[0]), float(q[1]))
+            if key not in sw._frames:
+                shadow, table, tid = sw.shadow(q)
+                sw._frames[key] = (shadow, sw._edges(shadow, table, tid))
+                self.stats["samples"] += 1
+            got = self.frames[t] = sw._frames[key]
+        return got
+
+
 @dataclass
 class Sweeper:
     """Swept shadows of one target (fixed orientation) moving along segments.
@@ -640,54 +675,75 @@ class Sweeper:
     def along(self, q0: np.ndarray, q1: np.ndarray) -> tuple[list[shapely.Geometry], dict]:
         """Pieces whose union is the union of the shadows S(q) for q on the
         segment ``q0 -> q1``, and counters (samples, traced edges, refinements)."""
-        q0, q1 = np.asarray(q0, dtype=float), np.asarray(q1, dtype=float)
+        pieces, stats = self.along_many([(q0, q1)])
+        return pieces[0], stats
+
+    def along_many(
+        self, segs: list[tuple], traced: Callable[[int], None] | None = None
+    ) -> tuple[list[list[shapely.Geometry]], dict]:
+        """:meth:`along` for each segment ``(q0, q1)`` of ``segs``: per segment its pieces,
+        and the counters summed; ``traced(i)`` is called once segment ``i`` is done (they are
+        traced in order, after the samples of all).
+
+        The same pieces as :meth:`along` segment by segment (every decision of a segment
+        depends on its own samples, and a shadow is a function of its configuration), with
+        the exact weak visibility regions that the birth checks and the event samples need
+        computed in one batch per round over all segments instead of one per segment (a lone
+        weak visibility region costs about twice its share of a batch)."""
         # the shadows of a sweep skip the corners that see no point of K (one weak
         # visibility of K, paid back over the samples; a lone shadow does without)
         self._grazing = self._anchors()
-        dq = q1 - q0
-        stats = {"samples": 0, "edges": 0, "refined": 0}
-        frames: dict[float, tuple] = {}
-
-        def frame(t: float) -> tuple:
-            if t not in frames:
-                q = q1 if t == 1.0 else q0 + t * dq
-                key = (float(q[0]), float(q[1]))
-                if key not in self._frames:  # shared by the edges meeting at a vertex of G
-                    shadow, table, tid = self.shadow(q)
-                    self._frames[key] = (shadow, self._edges(shadow, table, tid))
-                    stats["samples"] += 1
-                frames[t] = self._frames[key]
-            return frames[t]
-
-        ts = [float(t) for t in np.linspace(0.0, 1.0, self.n_samples + 1)]
-        for t in ts:
-            frame(t)
-        if not float(np.hypot(*dq)) > 0:
-            return [frames[0.0][0]], stats
-        ts = self._refine_births(ts, q0, dq, frame, stats)
+        runs = [_Run(self, np.asarray(a, dtype=float), np.asarray(b, dtype=float)) for a, b in segs]
+        ts_all = []
+        for run in runs:
+            ts = [float(t) for t in np.linspace(0.0, 1.0, self.n_samples + 1)]
+            for t in ts:
+                run.frame(t)
+            ts_all.append(ts)
+        moving = [r for r in runs if float(np.hypot(*r.dq)) > 0]
+        if moving:
+            self._refine_births_many(moving, [ts_all[runs.index(r)] for r in moving])
         # the collinearity events (shadows born on a line) are sampled lazily: once
         # between consecutive events next to a *live* event, one whose wedge's lines carry
         # a shadow edge at a sample so far (see _live_mids), until no new one is live;
         # first from the samples alone, then again after the refinements of the tracing
-        ev_t, ev_ids = self._events(q0, dq)
-        looked: set[int] = set()
-        while mids := self._live_mids(ev_t, ev_ids, frames, looked):
-            self._prefetch([q0 + t * dq for t in mids])
-            for t in mids:
-                frame(t)
-        ts = sorted(frames)
+        for r in moving:
+            r.ev_t, r.ev_ids = self._events(r.q0, r.dq)
+        while True:
+            asked = [(r, self._live_mids(r.ev_t, r.ev_ids, r.frames, r.looked)) for r in moving]
+            asked = [(r, mids) for r, mids in asked if mids]
+            if not asked:
+                break
+            self._prefetch([r.q0 + t * r.dq for r, mids in asked for t in mids])
+            for r, mids in asked:
+                for t in mids:
+                    r.frame(t)
+        out = []
+        for i, r in enumerate(runs):
+            out.append(self._trace_run(r) if r in moving else [r.frame(0.0)[0]])
+            if traced is not None:
+                traced(i)
+        stats = {k: sum(r.stats[k] for r in runs) for k in ("samples", "edges", "refined")}
+        return out, stats
+
+    def _trace_run(self, run: _Run) -> list[shapely.Geometry]:
+        """The pieces of one segment once its samples are taken: its sampled shadows, then
+        the traces between them (:meth:`_sweep_intervals`), asking :meth:`_live_mids`
+        again after the tracing's refinements."""
+        q0, q1, dq, frame, stats = run.q0, run.q1, run.dq, run.frame, run.stats
+        ts = sorted(run.frames)
         pieces = [frame(t)[0] for t in ts]
         state = _Cover()
         todo = [(a, b, 0) for a, b in zip(ts[:-1], ts[1:], strict=True)]
         while True:
             self._sweep_intervals(todo, q0, q1, frame, pieces, state, stats)
-            mids = self._live_mids(ev_t, ev_ids, frames, looked)
+            mids = self._live_mids(run.ev_t, run.ev_ids, run.frames, run.looked)
             if not mids:
-                return pieces, stats
+                return pieces
             self._prefetch([q0 + t * dq for t in mids])
             for t in mids:
                 pieces.append(frame(t)[0])
-            grid = sorted(set(frames) | set(mids))
+            grid = sorted(set(run.frames) | set(mids))
             todo = [
                 (a, b, 0)
                 for a, b in zip(grid[:-1], grid[1:], strict=True)
@@ -1187,9 +1243,9 @@ class Sweeper:
                 return 0.5 * (reach + b)
         return None
 
-    def _refine_births(self, ts: list, q0, dq, frame, stats) -> list:
-        """Add sample times where the eroded target's shadow has a component that
-        neither neighbouring sample's shadow meets (a shadow born and dying in
+    def _refine_births_many(self, runs: list[_Run], ts_all: list[list]) -> None:
+        """Add sample times (to each run's frames) where the eroded target's shadow has a
+        component that neither neighbouring sample's shadow meets (a shadow born and dying in
         between); bisect up to ``max_depth`` times, and on an interval without an eroded
         target only where one exists within that limit (:meth:`_core_within_depth`).  With
         overlap strips (5.2) the eroded
@@ -1197,40 +1253,41 @@ class Sweeper:
         shadows, which the 5.2 shadows contain, so a shadow of the full target born in
         between is caught here too (and the 5.2 region stays inside R(G); fuzz seed 411063,
         mixed G/H).  Births of shadows that exist only because pieces are unwanted are not
-        detected by it."""
-        todo = [(a, b, 0) for a, b in zip(ts[:-1], ts[1:], strict=True)]
-        out = set(ts)
-        # level by level (each decision depends on its interval alone, so the order does
-        # not matter): the eroded targets' regions of a level, then its new samples, are
-        # computed in one batch each
+        detected by it.  ``runs``: the segments, ``ts_all``: their sample times so far."""
+        todo = [
+            (r, a, b, 0)
+            for r, ts in zip(runs, ts_all, strict=True)
+            for a, b in zip(ts[:-1], ts[1:], strict=True)
+        ]
+        # level by level, over all segments (each decision depends on its interval alone, so
+        # the order does not matter): the eroded targets' regions of a level, then its new
+        # samples, are computed in one batch each
         while todo:
             self._check_time()
-            level = [(a, b, depth) for a, b, depth in todo if depth < self.max_depth]
-            self._prefetch_eroded([(q0 + a * dq, q0 + b * dq) for a, b, _ in level])
+            level = [(r, a, b, depth) for r, a, b, depth in todo if depth < self.max_depth]
+            self._prefetch_eroded([(r.q0 + a * r.dq, r.q0 + b * r.dq) for r, a, b, _ in level])
             todo, mids = [], []
-            for a, b, depth in level:
+            for r, a, b, depth in level:
                 self._check_time()
-                upper = self._eroded_shadow(q0 + a * dq, q0 + b * dq)
+                upper = self._eroded_shadow(r.q0 + a * r.dq, r.q0 + b * r.dq)
                 if upper is None:
                     # no eroded target: bisect where one exists within the depth limit
-                    new = self._core_within_depth(b - a, depth, dq)
+                    new = self._core_within_depth(b - a, depth, r.dq)
                 else:
                     parts = shapely.get_parts(upper)
                     parts = parts[~shapely.is_empty(parts)]  # an empty shadow: no new component
                     # meets the union of the two shadows = meets one of them (no overlay)
                     meets = np.zeros(len(parts), dtype=bool)
-                    for k in (frame(a)[0], frame(b)[0]):
+                    for k in (r.frame(a)[0], r.frame(b)[0]):
                         meets |= shapely.intersects(parts, k)
                     new = bool((~meets).any())
                 if new:
-                    mids.append((a, 0.5 * (a + b), b, depth))
-            self._prefetch([q0 + m * dq for _, m, _, _ in mids])
-            for a, m, b, depth in mids:
-                frame(m)
-                out.add(m)
-                stats["refined"] += 1
-                todo += [(a, m, depth + 1), (m, b, depth + 1)]
-        return sorted(out)
+                    mids.append((r, a, 0.5 * (a + b), b, depth))
+            self._prefetch([r.q0 + m * r.dq for r, _, m, _, _ in mids])
+            for r, a, m, b, depth in mids:
+                r.frame(m)
+                r.stats["refined"] += 1
+                todo += [(r, a, m, depth + 1), (r, m, b, depth + 1)]
 
     def _core_within_depth(self, span: float, depth: int, dq: np.ndarray) -> bool:
         """Whether the target has a non-empty eroded part (:meth:`_eroded_core`) over the
@@ -1287,9 +1344,12 @@ class Sweeper:
         ``pairs`` ((qa, qb) each), in one batch (:meth:`_prefetch`); kept until taken."""
         todo = []
         for qa, qb in pairs:
+            key = (tuple(qa.tolist()), tuple(qb.tolist()))
+            if key in self._eroded_pre:
+                continue
             got = self._eroded_core(qa, qb)
             if got is not None:
-                todo.append(((tuple(qa.tolist()), tuple(qb.tolist())), got[1]))
+                todo.append((key, got[1]))
         if len(todo) < 2:
             return
         rings = [r for _, r in todo]
@@ -1823,20 +1883,23 @@ def swept_shadows(
         # the same grazing mask)
         sw._grazing = sw._anchors()
         sw._prefetch([np.asarray(a, dtype=float) for a, _ in segs])
-        for done, (a, b) in enumerate(segs):
-            try:
-                got, st = sw.along(a, b)
-            except _Expired:
-                raise QueryTimeout(
-                    f"{what} ran past its timeout after sweeping {done} of the {len(segs)} "
-                    f"edges of the region's boundary ({len(segs) - done} left, the current "
-                    "one included); raise timeout= or give timeout=None"
-                ) from None
-            pieces += got
-            for k in stats:
-                stats[k] += st[k]
+        done = [0]
+
+        def traced(_: int) -> None:
+            done[0] += 1
             if progress is not None:
-                progress(done + 1, len(segs))
+                progress(done[0], len(segs))
+
+        try:
+            got, stats = sw.along_many(segs, traced)
+        except _Expired:
+            raise QueryTimeout(
+                f"{what} ran past its timeout after sweeping {done[0]} of the {len(segs)} "
+                f"edges of the region's boundary ({len(segs) - done[0]} left, the current "
+                "one included); raise timeout= or give timeout=None"
+            ) from None
+        for g in got:
+            pieces += g
     stats["grid"] = sw.grid
     if samples is not None:
         if region.geom_type == "Point":
