@@ -46,6 +46,7 @@ NAMES = (
     "regions",
     "scaling",
     "swept",
+    "swept_phases",
     "swept_accuracy",
     "train_profile",
     "train_study",

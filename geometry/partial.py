@@ -249,7 +249,9 @@ def _swept_region(
         shadows = shapely.union(shadows, pocket_area(target, region))
     out = polygonal(shapely.difference(allowed, shadows))
     if sink is not None:
-        sink.update(allowed=allowed, grid=stats["grid"], stand_in=stand_in, region=region)
+        sink.update(
+            allowed=allowed, grid=stats["grid"], stand_in=stand_in, region=region, stats=stats
+        )
     if eps_pos > 0:
         out = shrink_for_position(out, allowed, eps_pos)
     return out

@@ -53,9 +53,10 @@ docs/DESIGN.md.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -125,6 +126,28 @@ class _Cover:
     confirmed: set[tuple] = field(default_factory=set)
     traced: dict[tuple, list] = field(default_factory=dict)
     probed: list[tuple] = field(default_factory=list)
+
+
+class PhaseClock:
+    """Wall seconds and new samples per phase of a sweep (``with clock("tracing"): ...``):
+    ``seconds`` and ``samples`` map a phase name to its totals (a sample: an exact stationary
+    shadow, counted by the sweeper's ``_frames``; the birth checks' eroded targets are not
+    samples).  ``swept_shadows`` returns them in its stats (``stats["seconds"]``,
+    ``stats["phase_samples"]``); ``benchmarks.swept_phases`` tabulates them."""
+
+    def __init__(self, count: Callable[[], int]) -> None:
+        self.seconds: dict[str, float] = {}
+        self.samples: dict[str, int] = {}
+        self._count = count
+
+    @contextlib.contextmanager
+    def __call__(self, phase: str) -> Iterator[None]:
+        n0, t0 = self._count(), time.perf_counter()
+        try:
+            yield
+        finally:
+            self.seconds[phase] = self.seconds.get(phase, 0.0) + time.perf_counter() - t0
+            self.samples[phase] = self.samples.get(phase, 0) + self._count() - n0
 
 
 @dataclass(eq=False)
@@ -238,6 +261,8 @@ class Sweeper:
         #: ``grazing`` mask they were computed with
         self._weak_pre: dict[tuple[float, float], tuple] = {}
         self._eroded_pre: dict[tuple, shapely.Geometry] = {}
+        #: where the sweep's time went (:class:`PhaseClock`)
+        self.clock = PhaseClock(lambda: len(self._frames))
 
     # ------------------------------------------------------------------ anchors
     def pos(self, ids: np.ndarray, q: np.ndarray) -> np.ndarray:
@@ -692,35 +717,41 @@ class Sweeper:
         weak visibility region costs about twice its share of a batch)."""
         # the shadows of a sweep skip the corners that see no point of K (one weak
         # visibility of K, paid back over the samples; a lone shadow does without)
-        self._grazing = self._anchors()
+        clock = self.clock
+        with clock("anchors"):
+            self._grazing = self._anchors()
         runs = [_Run(self, np.asarray(a, dtype=float), np.asarray(b, dtype=float)) for a, b in segs]
         ts_all = []
-        for run in runs:
-            ts = [float(t) for t in np.linspace(0.0, 1.0, self.n_samples + 1)]
-            for t in ts:
-                run.frame(t)
-            ts_all.append(ts)
+        with clock("vertex samples"):
+            for run in runs:
+                ts = [float(t) for t in np.linspace(0.0, 1.0, self.n_samples + 1)]
+                for t in ts:
+                    run.frame(t)
+                ts_all.append(ts)
         moving = [r for r in runs if float(np.hypot(*r.dq)) > 0]
         if moving:
-            self._refine_births_many(moving, [ts_all[runs.index(r)] for r in moving])
+            with clock("birth checks"):
+                self._refine_births_many(moving, [ts_all[runs.index(r)] for r in moving])
         # the collinearity events (shadows born on a line) are sampled lazily: once
         # between consecutive events next to a *live* event, one whose wedge's lines carry
         # a shadow edge at a sample so far (see _live_mids), until no new one is live;
         # first from the samples alone, then again after the refinements of the tracing
-        for r in moving:
-            r.ev_t, r.ev_ids = self._events(r.q0, r.dq)
-        while True:
-            asked = [(r, self._live_mids(r.ev_t, r.ev_ids, r.frames, r.looked)) for r in moving]
-            asked = [(r, mids) for r, mids in asked if mids]
-            if not asked:
-                break
-            self._prefetch([r.q0 + t * r.dq for r, mids in asked for t in mids])
-            for r, mids in asked:
-                for t in mids:
-                    r.frame(t)
+        with clock("event samples"):
+            for r in moving:
+                r.ev_t, r.ev_ids = self._events(r.q0, r.dq)
+            while True:
+                asked = [(r, self._live_mids(r.ev_t, r.ev_ids, r.frames, r.looked)) for r in moving]
+                asked = [(r, mids) for r, mids in asked if mids]
+                if not asked:
+                    break
+                self._prefetch([r.q0 + t * r.dq for r, mids in asked for t in mids])
+                for r, mids in asked:
+                    for t in mids:
+                        r.frame(t)
         out = []
         for i, r in enumerate(runs):
-            out.append(self._trace_run(r) if r in moving else [r.frame(0.0)[0]])
+            with clock("tracing"):
+                out.append(self._trace_run(r) if r in moving else [r.frame(0.0)[0]])
             if traced is not None:
                 traced(i)
         stats = {k: sum(r.stats[k] for r in runs) for k in ("samples", "edges", "refined")}
@@ -1323,7 +1354,15 @@ class Sweeper:
 
     def _eroded_core(self, qa: np.ndarray, qb: np.ndarray) -> tuple | None:
         """The part of A common to all A_q, q in [qa, qb] (its largest piece) and its
-        outline (clockwise), or None when it is empty (:meth:`_eroded_shadow`)."""
+        outline (clockwise), or None when it is empty (:meth:`_eroded_shadow`); kept per
+        interval (the batch of :meth:`_prefetch_eroded` and the check ask for the same)."""
+        key = (tuple(qa.tolist()), tuple(qb.tolist()))
+        cache = self.__dict__.setdefault("_cores", {})
+        if key not in cache:
+            cache[key] = self._eroded_core_of(qa, qb)
+        return cache[key]
+
+    def _eroded_core_of(self, qa: np.ndarray, qb: np.ndarray) -> tuple | None:
         aa = shapely.Polygon(self.ring0 + qa)
         ab = shapely.Polygon(self.ring0 + qb)
         core = shapely.intersection(aa, ab)
@@ -1824,7 +1863,8 @@ def swept_shadows(
     region with the reference point moved into the target's kernel (the swept
     set of placements does not depend on that choice).  Returns the union (a
     shapely geometry, world frame) and counters (``stats["grid"]``: the snap-rounding
-    grid, below).
+    grid, below; ``stats["seconds"]`` and ``stats["phase_samples"]``: wall seconds and new
+    samples per phase, see :class:`PhaseClock`).
 
     The pieces (sampled shadows and traced quads, a few hundred for a long edge of G)
     are united by GEOS *snap-rounding* on a grid of ``2**-GRID_BITS`` of the scene's size
@@ -1881,8 +1921,10 @@ def swept_shadows(
         ]
         # the samples at the vertices of the region's boundary in one batch (along() sets
         # the same grazing mask)
-        sw._grazing = sw._anchors()
-        sw._prefetch([np.asarray(a, dtype=float) for a, _ in segs])
+        with sw.clock("anchors"):
+            sw._grazing = sw._anchors()
+        with sw.clock("vertex samples"):
+            sw._prefetch([np.asarray(a, dtype=float) for a, _ in segs])
         done = [0]
 
         def traced(_: int) -> None:
@@ -1912,7 +1954,11 @@ def swept_shadows(
                 for t in ts:
                     q = a + t * (b - a)
                     samples.append((q - c, sw.shadow(q)[0]))
-    return _union_pieces(sw, pieces), stats
+    with sw.clock("union"):
+        union = _union_pieces(sw, pieces)
+    stats["seconds"] = dict(sw.clock.seconds)
+    stats["phase_samples"] = dict(sw.clock.samples)
+    return union, stats
 
 
 def _union_pieces(sw: Sweeper, pieces: list[shapely.Geometry]) -> shapely.Geometry:

@@ -22,13 +22,13 @@ def test_the_slow_reproductions_come_with_their_orientation() -> None:
 
 def test_eager_sampling_only_inside_the_anchor_call(monkeypatch) -> None:
     flags: list[bool] = []
-    orig = S.Sweeper.along
+    orig = S.Sweeper.along_many
 
-    def along(self, q0, q1):
+    def along_many(self, *a, **k):
         flags.append(self.lazy_samples)
-        return orig(self, q0, q1)
+        return orig(self, *a, **k)
 
-    monkeypatch.setattr(S.Sweeper, "along", along)
+    monkeypatch.setattr(S.Sweeper, "along_many", along_many)
     lab = "sensorplan_gym/scenes/lab.json"
     rm._eager(lambda: partial_region(Scene.load(lab), target_in="goal", theta=0.0))
     assert S.LAZY_SAMPLES is True  # restored

@@ -132,13 +132,13 @@ def test_sweeper_point_test_deduplicated_and_window_first_gives_the_row_by_row_a
     import geometry.sweep as sweep
 
     got = []
-    along = sweep.Sweeper.along
+    along_many = sweep.Sweeper.along_many
 
-    def spy(self, a, b):
-        got.append((self, np.asarray(a, dtype=float), np.asarray(b, dtype=float)))
-        return along(self, a, b)
+    def spy(self, segs, *rest):
+        got.extend((self, np.asarray(a, dtype=float), np.asarray(b, dtype=float)) for a, b in segs)
+        return along_many(self, segs, *rest)
 
-    monkeypatch.setattr(sweep.Sweeper, "along", spy)
+    monkeypatch.setattr(sweep.Sweeper, "along_many", spy)
     sq = np.array([[-0.3, -0.3], [0.3, -0.3], [0.3, 0.3], [-0.3, 0.3]])
     sc = scene(
         target=[[-0.6, -0.4], [0.6, -0.4], [0.6, 0.4], [-0.6, 0.4]],

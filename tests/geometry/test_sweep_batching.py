@@ -36,13 +36,13 @@ def test_drop_short_matches_the_loop() -> None:
 
 def _sweeper(monkeypatch) -> S.Sweeper:
     got = {}
-    orig = S.Sweeper.along
+    orig = S.Sweeper.along_many
 
-    def along(self, q0, q1):
+    def along_many(self, *a, **k):
         got.setdefault("sw", self)
-        return orig(self, q0, q1)
+        return orig(self, *a, **k)
 
-    monkeypatch.setattr(S.Sweeper, "along", along)
+    monkeypatch.setattr(S.Sweeper, "along_many", along_many)
     partial_region(Scene.load("sensorplan_gym/scenes/lab.json"), target_in="goal", theta=0.0)
     return got["sw"]
 
@@ -205,17 +205,17 @@ def test_skipping_corners_blind_to_k_keeps_the_shadows(monkeypatch) -> None:
 def _sweep_with_pieces(monkeypatch, scene: str) -> tuple[S.Sweeper, list]:
     """A swept query on ``scene``: its sweeper and the pieces it united."""
     got: dict = {}
-    orig_along, orig_union = S.Sweeper.along, S._union_pieces
+    orig_along, orig_union = S.Sweeper.along_many, S._union_pieces
 
-    def along(self, q0, q1):
+    def along_many(self, *a, **k):
         got.setdefault("sw", self)
-        return orig_along(self, q0, q1)
+        return orig_along(self, *a, **k)
 
     def union(sw, pieces):
         got["pieces"] = list(pieces)
         return orig_union(sw, pieces)
 
-    monkeypatch.setattr(S.Sweeper, "along", along)
+    monkeypatch.setattr(S.Sweeper, "along_many", along_many)
     monkeypatch.setattr(S, "_union_pieces", union)
     partial_region(Scene.load(f"sensorplan_gym/scenes/{scene}.json"), target_in="goal", theta=0.0)
     return got["sw"], got["pieces"]

@@ -17,6 +17,7 @@ import shapely
 from geometry import Scene, partial_region, recognizable_region
 from geometry import sweep as S
 from geometry._common import scene_domain
+from geometry._shapes import ccw_ring
 from geometry.fuzz import fuzz_scene
 from sensorplan_gym.core.scenes import load_scene
 
@@ -187,3 +188,30 @@ def test_a_sliver_sweep_is_the_eager_one_with_fewer_samples(monkeypatch) -> None
     tol = 1e-4 * Scene.from_dict(d["scene"]).diameter
     assert max(_depth(got[True][0], got[False][0]), _depth(got[False][0], got[True][0])) <= 2 * tol
     assert got[True][1] < 0.6 * got[False][1]
+
+
+@pytest.mark.parametrize("name", ["lab", "real/heidelberg_l2", "fuzz:200326"])
+def test_batched_edges_give_the_pieces_of_one_edge_at_a_time(name) -> None:
+    """:meth:`~geometry.sweep.Sweeper.along_many` batches the weak visibility regions of all
+    edges of G; every decision is per edge, so the pieces are those of :meth:`along` edge by
+    edge, bit for bit.  Its phase clock accounts for every sample."""
+    scene = _scene(name)
+    target = ccw_ring(scene.target_at(0.0, 0.0, 0.0))
+    ring0 = target - S.star_center(target)
+    coords = np.asarray(shapely.orient_polygons(scene.goal_geom, exterior_cw=False).exterior.coords)
+    segs = list(zip(coords[:-1], coords[1:], strict=True))
+    hull = shapely.convex_hull(shapely.multipoints((ring0[:, None] + coords[None]).reshape(-1, 2)))
+    hull = np.asarray(shapely.orient_polygons(hull, exterior_cw=False).exterior.coords)[:-1]
+    tol = 1e-4 * scene.diameter
+
+    def sweeper() -> S.Sweeper:
+        return S.Sweeper(scene_domain(scene), scene.free_space, ring0, hull, None, 0.0, tol)
+
+    one = sweeper()
+    one_by_one = [one.along(a, b)[0] for a, b in segs]
+    many = sweeper()
+    batched, stats = many.along_many(segs)
+    for p, q in zip(one_by_one, batched, strict=True):
+        assert [shapely.to_wkb(g) for g in p] == [shapely.to_wkb(g) for g in q]
+    assert sum(many.clock.samples.values()) == len(many._frames) == stats["samples"]
+    assert set(many.clock.seconds) >= {"anchors", "vertex samples", "birth checks", "tracing"}

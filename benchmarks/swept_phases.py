@@ -1,0 +1,161 @@
+"""Where the time of a swept partial query goes, in units of the stationary query.
+
+    python -m benchmarks.swept_phases              # about two minutes
+    python -m benchmarks.swept_phases --reps 7 --update-results
+
+For every real map of :mod:`benchmarks.real_maps` (and the fuzzer's slow reproductions), the
+swept partial query over G (paper 3.2.2-3.2.3, ``partial_region(target_in="goal")``) split
+into the phases of :func:`geometry.sweep.swept_shadows` as its :class:`~geometry.sweep.PhaseClock`
+reports them (median over ``--reps`` calls, each on a freshly loaded scene, after one
+warm-up call), each as a multiple of the stationary partial query on the same scene measured
+in the same run (the anchor), with the exact stationary shadows ("samples") each phase took:
+
+* *K's corners*: the one weak visibility region of K = CH(A + G) that tells which obstacle
+  corners can graze a beam into the target;
+* *vertex samples*: the shadows at the vertices of G;
+* *birth checks*: the eroded targets' shadows on every interval, and the samples they bisect
+  with;
+* *event samples*: the collinearity events and the samples next to the live ones;
+* *tracing*: the moving shadow edges traced between the samples (exact point tests) and the
+  samples its refinements add;
+* *union*: the union of the pieces.
+
+The table says which parts a faster sweep has to change: the issue-25 target (10x the
+stationary query) is below the cost of the vertex samples plus the birth checks plus the
+tracing on the office maps.  Data (``swept_phases.json``) and fragment (``swept_phases.md``) go
+to ``--out`` (default ``runs/benchmarks/swept_phases/``) or, with ``--update-results``, to
+``benchmarks/results/`` and ``docs/results/``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import time
+from typing import Any
+
+from geometry import partial_region
+from geometry.partial import _swept_region
+
+from . import _results
+from .real_maps import SLOW_REPROS, _cases, _pose
+
+#: The phases of the sweep, in the order they run, with their column titles.
+PHASES = {
+    "anchors": "K's corners",
+    "vertex samples": "vertex samples",
+    "birth checks": "birth checks",
+    "event samples": "event samples",
+    "tracing": "tracing",
+    "union": "union",
+}
+
+
+def run(reps: int, slow: bool = True) -> dict[str, Any]:
+    """Per scene: the stationary partial query's median seconds, the swept query's median
+    total and per-phase seconds, and its samples per phase."""
+    rows = []
+    for name, _src, load, theta in _cases():
+        if not slow and name in SLOW_REPROS:
+            continue
+        s = load()
+        edges = len(s.bounds) + sum(len(o) for o in s.obstacles)
+        partial_region(s, target_at=_pose(s, theta))
+        stationary = []
+        for _ in range(reps):
+            s = load()
+            t0 = time.perf_counter()
+            partial_region(s, target_at=_pose(s, theta))
+            stationary.append(time.perf_counter() - t0)
+        runs = []
+        for k in range(reps + 1):  # the first call warms up
+            s = load()
+            sink: dict[str, Any] = {}
+            t0 = time.perf_counter()
+            _swept_region(s, "goal", theta, 0.0, 0.0, None, False, sink=sink)
+            total = time.perf_counter() - t0
+            if k:
+                runs.append((total, sink["stats"]))
+        stats = runs[0][1]
+        row = {
+            "scene": name,
+            "edges": edges,
+            "theta": theta,
+            "stationary_s": statistics.median(stationary),
+            "swept_s": statistics.median(t for t, _ in runs),
+            "phase_s": {
+                p: statistics.median(st["seconds"].get(p, 0.0) for _, st in runs) for p in PHASES
+            },
+            "rest_s": statistics.median(t - sum(st["seconds"].values()) for t, st in runs),
+            "phase_samples": {p: stats["phase_samples"].get(p, 0) for p in PHASES},
+            "samples": sum(stats["phase_samples"].values()),
+        }
+        rows.append(row)
+        print(
+            f"  {name:>14} stationary {1e3 * row['stationary_s']:6.1f} ms  swept "
+            f"{1e3 * row['swept_s']:7.1f} ms  "
+            + "  ".join(
+                f"{p} {row['phase_s'][p] / row['stationary_s']:.1f}x ({row['phase_samples'][p]})"
+                for p in PHASES
+            )
+        )
+    return {"reps": reps, "rows": rows}
+
+
+def render(data: dict[str, Any]) -> str:
+    """The page fragment: per scene the phases as multiples of the stationary partial query
+    (samples in parentheses)."""
+    lines = [
+        "| scene | edges | stationary partial | swept over G | "
+        + " | ".join(PHASES.values())
+        + " | rest |",
+        "| --- | ---: | ---: | ---: |" + " ---: |" * (len(PHASES) + 1),
+    ]
+    for r in data["rows"]:
+        st = r["stationary_s"]
+        cells = [
+            r["scene"],
+            str(r["edges"]),
+            f"{1e3 * st:.1f} ms",
+            f"{r['swept_s'] / st:.1f}x ({r['samples']})",
+        ]
+        for p in PHASES:
+            n = r["phase_samples"][p]
+            cells.append(f"{r['phase_s'][p] / st:.1f}x" + (f" ({n})" if n else ""))
+        cells.append(f"{r['rest_s'] / st:.1f}x")
+        lines.append("| " + " | ".join(cells) + " |")
+    m = data["machine"]
+    lines += [
+        "",
+        f"`{data['command']}`: medians of {data['reps']} calls, each on a freshly loaded scene "
+        "(after one warm-up call), each phase as a multiple of the stationary partial query on "
+        "the same scene in the same run (its median in the third column; the phases' medians "
+        "need not add up to the query's); in parentheses the exact "
+        "stationary shadows (samples) the phase took; *rest*: the query's own work around the "
+        "sweep (the scene's domain, the final difference). G a regular pentagon on the real "
+        "maps; `slow_1`, `slow_2` the independent fuzzer's reproductions with their own G, "
+        f"target and orientation; {m['cpus']} CPUs, Python {m['python']}, load average "
+        f"{m['load_average']}.",
+    ]
+    return "\n".join(lines) + "\n"
+
+
+def main(argv: list[str] | None = None) -> None:
+    ap = argparse.ArgumentParser(
+        prog="python -m benchmarks.swept_phases", description=__doc__.split("\n\n")[0]
+    )
+    ap.add_argument("--reps", type=int, default=5)
+    ap.add_argument("--no-slow", action="store_true", help="the real maps only")
+    _results.add_output_args(ap, "swept_phases")
+    args = ap.parse_args(argv)
+    data = {
+        "command": _results.command("benchmarks.swept_phases", argv),
+        "machine": _results.machine(),
+        **run(args.reps, slow=not args.no_slow),
+    }
+    print(render(data))
+    _results.write("swept_phases", data, args.out, args.update_results)
+
+
+if __name__ == "__main__":
+    main()
