@@ -214,6 +214,10 @@ class Sweeper:
     max_depth: int = 6
     bisect_steps: int = 14
     probes: int = 4
+    #: the birth check bounds an interval without an eroded target by the eroded targets of
+    #: its pieces after at most this many halvings (``2**max_split`` weak visibility regions
+    #: instead of a sample and two checks per level; lazy rule only)
+    max_split: int = 2
     #: sample only next to the collinearity events whose wedge lines carry a shadow edge
     #: (:meth:`_live_mids`), and bisect for births only where an eroded target exists within
     #: the depth limit (:meth:`_core_within_depth`); False: next to every event and on every
@@ -1277,8 +1281,12 @@ class Sweeper:
     def _refine_births_many(self, runs: list[_Run], ts_all: list[list]) -> None:
         """Add sample times (to each run's frames) where the eroded target's shadow has a
         component that neither neighbouring sample's shadow meets (a shadow born and dying in
-        between); bisect up to ``max_depth`` times, and on an interval without an eroded
-        target only where one exists within that limit (:meth:`_core_within_depth`).  With
+        between, :meth:`_born`); bisect up to ``max_depth`` times.  An interval without an
+        eroded target is bounded by the union of its pieces' eroded targets' shadows where
+        halving it at most ``max_split`` times gives each piece one (lazy rule,
+        :meth:`_split_shadow`; a component of that union apart from both ends' shadows is
+        bisected as before), else bisected where an eroded target exists within the depth
+        limit (:meth:`_core_within_depth`).  With
         overlap strips (5.2) the eroded
         target's whole outline counts as wanted: its shadow bounds the full target's
         shadows, which the 5.2 shadows contain, so a shadow of the full target born in
@@ -1296,22 +1304,33 @@ class Sweeper:
         while todo:
             self._check_time()
             level = [(r, a, b, depth) for r, a, b, depth in todo if depth < self.max_depth]
-            self._prefetch_eroded([(r.q0 + a * r.dq, r.q0 + b * r.dq) for r, a, b, _ in level])
+            pairs = [(r.q0 + a * r.dq, r.q0 + b * r.dq) for r, a, b, _ in level]
+            # an interval without an eroded target (the target moves further than its own
+            # thickness) is bounded by the eroded targets of its pieces where halving it k
+            # times gives them one (lazy rule; the previous rule bisects with samples)
+            split: dict[int, list] = {}
+            if self.lazy_samples:
+                for i, ((r, a, b, depth), (qa, qb)) in enumerate(zip(level, pairs, strict=True)):
+                    if self._eroded_core(qa, qb) is None:
+                        k = self._split_depth(b - a, depth, r.dq)
+                        if k is None or k > self.max_split:
+                            continue  # bisect with samples (or not at all, as before)
+                        ts = np.linspace(a, b, 2**k + 1)
+                        qs = [r.q0 + t * r.dq for t in ts]
+                        split[i] = list(zip(qs[:-1], qs[1:], strict=False))
+            self._prefetch_eroded(pairs + [p for ps in split.values() for p in ps])
             todo, mids = [], []
-            for r, a, b, depth in level:
+            for i, (r, a, b, depth) in enumerate(level):
                 self._check_time()
-                upper = self._eroded_shadow(r.q0 + a * r.dq, r.q0 + b * r.dq)
+                if i in split:
+                    upper = self._split_shadow(split[i])
+                else:
+                    upper = self._eroded_shadow(*pairs[i])
                 if upper is None:
                     # no eroded target: bisect where one exists within the depth limit
                     new = self._core_within_depth(b - a, depth, r.dq)
                 else:
-                    parts = shapely.get_parts(upper)
-                    parts = parts[~shapely.is_empty(parts)]  # an empty shadow: no new component
-                    # meets the union of the two shadows = meets one of them (no overlay)
-                    meets = np.zeros(len(parts), dtype=bool)
-                    for k in (r.frame(a)[0], r.frame(b)[0]):
-                        meets |= shapely.intersects(parts, k)
-                    new = bool((~meets).any())
+                    new = len(self._born(upper, r.frame(a)[0], r.frame(b)[0])) > 0
                 if new:
                     mids.append((r, a, 0.5 * (a + b), b, depth))
             self._prefetch([r.q0 + m * r.dq for r, _, m, _, _ in mids])
@@ -1319,6 +1338,23 @@ class Sweeper:
                 r.frame(m)
                 r.stats["refined"] += 1
                 todo += [(r, a, m, depth + 1), (r, m, b, depth + 1)]
+
+    def _born(
+        self, upper: shapely.Geometry, sa: shapely.Geometry, sb: shapely.Geometry
+    ) -> np.ndarray:
+        """The parts of the upper bound ``upper`` of the shadows over an interval that meet
+        neither end's shadow (``sa``, ``sb``): where a shadow may be born and gone in between.
+        With the lazy rules, parts narrower than the union's snap grid (twice their area over
+        their perimeter) do not count: they are rounding (heidelberg_l2: a sliver 6e-16 D wide,
+        a few ulps of its coordinates), and the union's snap-rounding would collapse such a
+        shadow into a line anyway."""
+        parts = shapely.get_parts(upper)
+        parts = parts[~shapely.is_empty(parts)]  # an empty shadow: no new component
+        if self.lazy_samples:
+            parts = parts[2.0 * shapely.area(parts) > self.grid * shapely.length(parts)]
+        # meets the union of the two shadows = meets one of them (no overlay)
+        meets = shapely.intersects(parts, sa) | shapely.intersects(parts, sb)
+        return parts[~meets]
 
     def _core_within_depth(self, span: float, depth: int, dq: np.ndarray) -> bool:
         """Whether the target has a non-empty eroded part (:meth:`_eroded_core`) over the
@@ -1337,7 +1373,14 @@ class Sweeper:
     def _eroded_shadow(self, qa: np.ndarray, qb: np.ndarray) -> shapely.Geometry | None:
         """Shadow of the part of A common to all A_q, q in [qa, qb] (it contains
         every S(q) there); None when that part is empty."""
+        seen = self._eroded_seen(qa, qb)
+        if seen is None:
+            return None
+        return polygonal(snapped(shapely.difference, self.free, seen, self.shadow_grid))
 
+    def _eroded_seen(self, qa: np.ndarray, qb: np.ndarray) -> shapely.Geometry | None:
+        """The placements that see the part of A common to all A_q, q in [qa, qb], or lie in
+        it (that part and its weak visibility region, snap-rounded); None when it is empty."""
         got = self._eroded_core(qa, qb)
         if got is None:
             return None
@@ -1349,8 +1392,29 @@ class Sweeper:
             )
         g = self.shadow_grid  # as in shadow(): the region's hole nearly coincides with core
         # snap-rounding can raise "Ring edge missing" at scale 1e-3 (fuzz seed 201039, --swept)
-        seen = areal(snapped(shapely.union, reg, core, g))
-        return polygonal(snapped(shapely.difference, self.free, seen, g))
+        return areal(snapped(shapely.union, reg, core, g))
+
+    def _split_shadow(self, pieces: list[tuple[np.ndarray, np.ndarray]]) -> shapely.Geometry:
+        """The union of the eroded targets' shadows (:meth:`_eroded_shadow`) of the
+        sub-intervals ``pieces`` ((qa, qb) each, every one with an eroded target): it contains
+        every S(q) of their union.  As in :func:`_union_pieces`, the free space minus the
+        intersection of what they do not hold."""
+        g = self.shadow_grid
+        xs = [self._eroded_seen(qa, qb) for qa, qb in pieces]
+        while len(xs) > 1:
+            pairs = zip(xs[0::2], xs[1::2], strict=False)  # an odd one out waits a round
+            nxt = [areal(snapped(shapely.intersection, a, b, g)) for a, b in pairs]
+            xs = nxt + xs[len(nxt) * 2 :]
+        return polygonal(snapped(shapely.difference, self.free, xs[0], g))
+
+    def _split_depth(self, span: float, depth: int, dq: np.ndarray) -> int | None:
+        """The fewest halvings ``k >= 1`` of an interval ``span`` long (in t) at ``depth``
+        after which the target has an eroded part over each piece, with ``depth + k`` below
+        ``max_depth`` (the deepest the birth check looks); None when there is none."""
+        for k in range(1, self.max_depth - depth):
+            if self._eroded_core(np.zeros(2), math.ldexp(span, -k) * dq) is not None:
+                return k
+        return None
 
     def _eroded_core(self, qa: np.ndarray, qb: np.ndarray) -> tuple | None:
         """The part of A common to all A_q, q in [qa, qb] (its largest piece) and its

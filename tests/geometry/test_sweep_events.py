@@ -215,3 +215,51 @@ def test_batched_edges_give_the_pieces_of_one_edge_at_a_time(name) -> None:
         assert [shapely.to_wkb(g) for g in p] == [shapely.to_wkb(g) for g in q]
     assert sum(many.clock.samples.values()) == len(many._frames) == stats["samples"]
     assert set(many.clock.seconds) >= {"anchors", "vertex samples", "birth checks", "tracing"}
+
+
+def test_the_birth_check_ignores_parts_narrower_than_the_union_grid() -> None:
+    """A part of the eroded target's shadow narrower than the union's snap grid (heidelberg_l2:
+    a sliver a few ulps wide, 5e-22 D^2, that took two samples and three more checks) is no
+    shadow born; one ten grid cells wide is, and the previous rules count both."""
+    scene = Scene.load("sensorplan_gym/scenes/lab.json")
+    ring = np.array([[-0.1, -0.1], [0.1, -0.1], [0.1, 0.1], [-0.1, 0.1]])
+    sw = S.Sweeper(scene_domain(scene), scene.free_space, ring, ring, None, 0.0, 1e-3)
+    g = sw.grid
+    old = shapely.box(0.0, 0.0, 1.0, 1.0)  # meets an end's shadow: not new
+    thin = shapely.box(2.0, 2.0, 3.0, 2.0 + 0.1 * g)
+    wide = shapely.box(4.0, 4.0, 5.0, 4.0 + 10.0 * g)
+    upper = shapely.MultiPolygon([old, thin, wide])
+    got = sw._born(upper, old, shapely.Polygon())
+    assert [p.equals(wide) for p in got] == [True]
+    sw.lazy_samples = False
+    assert len(sw._born(upper, old, shapely.Polygon())) == 2
+
+
+def test_an_edge_without_eroded_target_is_bounded_by_its_halves(monkeypatch) -> None:
+    """heidelberg_l1: the target is thinner than two edges of G in their direction, so their
+    eroded targets are empty; the union of the two halves' eroded shadows bounds them, and no
+    birth sample is taken (one per such edge when each is bisected with a sample,
+    ``max_split = 0``); the conservative regions agree within 2 tol."""
+    name = "real/heidelberg_l1"
+    kw = {"theta": 0.0, "timeout": None, "conservative": True}
+
+    def run():
+        return _with_rule(
+            True,
+            lambda: partial_region(_scene(name), target_in="goal", **kw),
+            monkeypatch,
+        )
+
+    split, made = run()
+    assert made[0].clock.samples.get("birth checks", 0) == 0
+    post_init = S.Sweeper.__post_init__
+
+    def no_split(self) -> None:
+        post_init(self)
+        self.max_split = 0
+
+    monkeypatch.setattr(S.Sweeper, "__post_init__", no_split)
+    bisected, made = run()
+    assert made[0].clock.samples["birth checks"] >= 2
+    tol = 1e-4 * _scene(name).diameter
+    assert max(_depth(split, bisected), _depth(bisected, split)) <= 2 * tol
