@@ -901,7 +901,7 @@ class Sweeper:
         b, i, j = self._event_lines()
         env = self.env
         # obstacle edges with a convex end (a beam can graze along them past that end)
-        cvx = np.flatnonzero(env.reflex)
+        cvx = self._event_corners()
         p0 = np.vstack([b[i], env.vert[cvx], env.vert[cvx]])
         p1 = np.vstack([b[j], env.vert_next[cvx], env.vert_prev[cvx]])
         w = p1 - p0
@@ -1041,8 +1041,9 @@ class Sweeper:
         )
         one_side = ~(((side > 0) & ~zero).any(axis=1) & ((side < 0) & ~zero).any(axis=1))
         env = self.env
-        bp = env.vert_prev[env.reflex][lb] - b[lb]
-        bn = env.vert_next[env.reflex][lb] - b[lb]
+        cvx = self._event_corners()
+        bp = env.vert_prev[cvx][lb] - b[lb]
+        bn = env.vert_next[cvx][lb] - b[lb]
         graze = _tangent(wt, bp, bn)
         return np.concatenate([keep_a, one_side & graze])
 
@@ -1055,13 +1056,29 @@ class Sweeper:
         got = getattr(self, "_ev_lines", None)
         if got is None:
             env = self.env
-            b = env.vert[env.reflex]
-            bp = env.vert_prev[env.reflex] - b
-            bn = env.vert_next[env.reflex] - b
+            cvx = self._event_corners()
+            b = env.vert[cvx]
+            bp = env.vert_prev[cvx] - b
+            bn = env.vert_next[cvx] - b
             i, j = np.triu_indices(len(b), 1)
             w = b[j] - b[i]
             ok = _tangent(w, bp[i], bn[i]) & _tangent(w, bp[j], bn[j])
             got = self._ev_lines = (b, i[ok], j[ok])
+        return got
+
+    def _event_corners(self) -> np.ndarray:
+        """Indices of the environment vertices that anchor collinearity events: the convex
+        obstacle corners that see K (:meth:`_anchors`; cached).  An event counts only when
+        the line's piece spanning its anchors lies in the free space, and one of them is on
+        the target, inside K, so both corners of an event line see K (up to the free
+        space's ``tol_lab`` growth: a line that merely grazes an obstacle between a corner
+        and K is dropped with it; measured, see docs/DESIGN.md).  On office maps most
+        corners see no point of K, and the pairs of corners were most of the events' cost.
+        With ``lazy_samples=False`` (the previous rules): every convex corner."""
+        got = getattr(self, "_ev_corners", None)
+        if got is None:
+            keep = self.env.reflex & (self._anchors() if self.lazy_samples else True)
+            got = self._ev_corners = np.flatnonzero(keep)
         return got
 
     def _free_near(self) -> shapely.Geometry:

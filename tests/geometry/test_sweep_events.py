@@ -263,3 +263,33 @@ def test_an_edge_without_eroded_target_is_bounded_by_its_halves(monkeypatch) -> 
     assert made[0].clock.samples["birth checks"] >= 2
     tol = 1e-4 * _scene(name).diameter
     assert max(_depth(split, bisected), _depth(bisected, split)) <= 2 * tol
+
+
+@pytest.mark.parametrize("name", SCENES)
+def test_events_from_the_corners_that_see_k_give_the_regions_of_every_corner(
+    name, monkeypatch
+) -> None:
+    """:meth:`~geometry.sweep.Sweeper._events` takes its lines through the convex corners that
+    see K only (an event's line is unobstructed between its anchors, one of them inside K).
+    The regions are those of events through every convex corner (on fuzz:200326 and
+    fuzz:200007 the events decide the region: see the test above), with no more events."""
+    lazy, made = _run(name, monkeypatch, lazy=True)
+    post_init = S.Sweeper.__post_init__
+
+    def every_corner(self) -> None:
+        post_init(self)
+        self._ev_corners = np.flatnonzero(self.env.reflex)  # what _event_corners keeps
+
+    with monkeypatch.context() as m:
+        m.setattr(S.Sweeper, "__post_init__", every_corner)
+        every, made_every = _run(name, monkeypatch, lazy=True)
+    tol = 1e-4 * _scene(name).diameter
+    for q in every:
+        deep = max(_depth(lazy[q], every[q]), _depth(every[q], lazy[q]))
+        assert deep <= 2 * tol, f"{name} {q}: {deep / tol:.3g} tol apart"
+    for sw, sw_every in zip(made, made_every, strict=True):
+        keys = list(sw._frames)
+        for q0, q1 in zip(keys[:-1], keys[1:], strict=True):
+            q0, q1 = np.asarray(q0), np.asarray(q1)
+            assert len(sw._events(q0, q1 - q0)[0]) <= len(sw_every._events(q0, q1 - q0)[0])
+        assert len(sw._event_corners()) <= int(sw.env.reflex.sum())
