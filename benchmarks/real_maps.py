@@ -193,23 +193,34 @@ def render(data: dict[str, Any]) -> str:
     return "\n".join(lines) + "\n"
 
 
-def main(argv: list[str] | None = None) -> None:
-    ap = argparse.ArgumentParser(
-        prog="python -m benchmarks.real_maps", description=__doc__.split("\n\n")[0]
-    )
+def cli(
+    name: str,
+    doc: str,
+    run_fn: Callable[..., dict[str, Any]],
+    render_fn: Callable[[dict[str, Any]], str],
+    argv: list[str] | None,
+) -> None:
+    """The command line of a benchmark over the real maps (``--reps``, ``--no-slow`` and the
+    output options): runs ``run_fn(reps, slow=...)``, prints ``render_fn`` of the data and
+    writes it as benchmark ``name``."""
+    ap = argparse.ArgumentParser(prog=f"python -m benchmarks.{name}", description=doc)
     ap.add_argument("--reps", type=int, default=5)
     ap.add_argument(
         "--no-slow", action="store_true", help="leave out the fuzzer's slow reproductions"
     )
-    _results.add_output_args(ap, "real_maps")
+    _results.add_output_args(ap, name)
     args = ap.parse_args(argv)
     data = {
-        "command": _results.command("benchmarks.real_maps", argv),
+        "command": _results.command(f"benchmarks.{name}", argv),
         "machine": _results.machine(),
-        **run(args.reps, slow=not args.no_slow),
+        **run_fn(args.reps, slow=not args.no_slow),
     }
-    print(render(data))
-    _results.write("real_maps", data, args.out, args.update_results)
+    print(render_fn(data))
+    _results.write(name, data, args.out, args.update_results)
+
+
+def main(argv: list[str] | None = None) -> None:
+    cli("real_maps", __doc__.split("\n\n")[0], run, render, argv)
 
 
 if __name__ == "__main__":

@@ -29,7 +29,6 @@ to ``--out`` (default ``runs/benchmarks/swept_phases/``) or, with ``--update-res
 
 from __future__ import annotations
 
-import argparse
 import statistics
 import time
 from typing import Any
@@ -37,8 +36,7 @@ from typing import Any
 from geometry import partial_region
 from geometry.partial import _swept_region
 
-from . import _results
-from .real_maps import SLOW_REPROS, _cases, _pose
+from .real_maps import SLOW_REPROS, _cases, _pose, cli
 
 #: The phases of the sweep, in the order they run, with their column titles.
 PHASES = {
@@ -141,20 +139,7 @@ def render(data: dict[str, Any]) -> str:
 
 
 def main(argv: list[str] | None = None) -> None:
-    ap = argparse.ArgumentParser(
-        prog="python -m benchmarks.swept_phases", description=__doc__.split("\n\n")[0]
-    )
-    ap.add_argument("--reps", type=int, default=5)
-    ap.add_argument("--no-slow", action="store_true", help="the real maps only")
-    _results.add_output_args(ap, "swept_phases")
-    args = ap.parse_args(argv)
-    data = {
-        "command": _results.command("benchmarks.swept_phases", argv),
-        "machine": _results.machine(),
-        **run(args.reps, slow=not args.no_slow),
-    }
-    print(render(data))
-    _results.write("swept_phases", data, args.out, args.update_results)
+    cli("swept_phases", __doc__.split("\n\n")[0], run, render, argv)
 
 
 if __name__ == "__main__":
