@@ -361,27 +361,46 @@ class Sweeper:
         tid = np.concatenate([np.arange(self.n_fixed), ids])
         return polygonal(shadow), table, tid
 
-    def _prefetch(self, qs: list[np.ndarray]) -> None:
+    def _prefetch(
+        self, qs: list[np.ndarray], eroded: list[tuple[np.ndarray, np.ndarray]] = ()
+    ) -> None:
         """The weak visibility regions that :meth:`shadow` needs at the reference points
-        ``qs`` (those not sampled yet), computed in one batch by
+        ``qs`` (those not sampled yet) and that :meth:`_eroded_shadow` needs for the
+        intervals ``eroded`` ((qa, qb) each), computed in one batch by
         :func:`~geometry.weak.weak_visibility_many` (bit for bit the regions
         :func:`~geometry.weak.weak_visibility` gives one by one; the ray casting of all
-        targets together) and kept until :meth:`shadow` takes them."""
-        todo = []
+        targets together) and kept until taken."""
+        todo, keys = [], set()
         for q in qs:
             key = (float(q[0]), float(q[1]))
-            if key in self._frames or key in self._weak_pre:
+            if key in self._frames or key in self._weak_pre or key in keys:
                 continue
+            keys.add(key)
             ring, wanted, _ = self.outline(q)
             if wanted.any():
                 todo.append((key, ring[::-1], np.roll(wanted[::-1], -1)))
-        if len(todo) < 2:
+        todo_e = []
+        for qa, qb in eroded:
+            key = (tuple(qa.tolist()), tuple(qb.tolist()))
+            if key in self._eroded_pre or key in keys:
+                continue
+            keys.add(key)
+            got = self._eroded_core(qa, qb)
+            if got is not None:
+                todo_e.append((key, got[1]))
+        if todo and todo_e and self._anchors() is not self._grazing:
+            self._prefetch([], eroded)  # different grazing masks: two batches
+            todo_e = []
+        if len(todo) + len(todo_e) < 2:
             return
-        regs = weak_visibility_many(
-            self.env, [r for _, r, _ in todo], [w for _, _, w in todo], self.eps_aim, self._grazing
-        )
-        for (key, _, _), reg in zip(todo, regs, strict=True):
+        rings = [r for _, r, _ in todo] + [r for _, r in todo_e]
+        wanted = [w for _, _, w in todo] + [np.ones(len(r), dtype=bool) for _, r in todo_e]
+        grazing = self._grazing if todo else self._anchors()
+        regs = weak_visibility_many(self.env, rings, wanted, self.eps_aim, grazing)
+        for (key, _, _), reg in zip(todo, regs[: len(todo)], strict=True):
             self._weak_pre[key] = (reg, self._grazing)
+        for (key, _), reg in zip(todo_e, regs[len(todo) :], strict=True):
+            self._eroded_pre[key] = reg
 
     def _edges(self, shadow: shapely.Geometry, table: np.ndarray, tid: np.ndarray) -> list:
         """Edges of ``shadow`` on moving lines: ``(key_prev, key, key_next)``, each
@@ -725,14 +744,29 @@ class Sweeper:
         with clock("anchors"):
             self._grazing = self._anchors()
         runs = [_Run(self, np.asarray(a, dtype=float), np.asarray(b, dtype=float)) for a, b in segs]
-        ts_all = []
+        ts_all = [[float(t) for t in np.linspace(0.0, 1.0, self.n_samples + 1)] for _ in runs]
+        moving = [r for r in runs if float(np.hypot(*r.dq)) > 0]
         with clock("vertex samples"):
-            for run in runs:
-                ts = [float(t) for t in np.linspace(0.0, 1.0, self.n_samples + 1)]
+            # the samples and the first level of the birth checks' eroded targets (which do
+            # not depend on the samples) in one batch
+            level = [
+                (r, a, b, 0)
+                for r, ts in zip(runs, ts_all, strict=True)
+                if r in moving
+                for a, b in zip(ts[:-1], ts[1:], strict=True)
+            ]
+            pairs, split = self._birth_bounds(level) if moving else ([], {})
+            self._prefetch(
+                [
+                    r.q1 if t == 1.0 else r.q0 + t * r.dq
+                    for r, ts in zip(runs, ts_all, strict=True)
+                    for t in ts
+                ],
+                pairs + [p for ps in split.values() for p in ps],
+            )
+            for run, ts in zip(runs, ts_all, strict=True):
                 for t in ts:
                     run.frame(t)
-                ts_all.append(ts)
-        moving = [r for r in runs if float(np.hypot(*r.dq)) > 0]
         if moving:
             with clock("birth checks"):
                 self._refine_births_many(moving, [ts_all[runs.index(r)] for r in moving])
@@ -1321,21 +1355,8 @@ class Sweeper:
         while todo:
             self._check_time()
             level = [(r, a, b, depth) for r, a, b, depth in todo if depth < self.max_depth]
-            pairs = [(r.q0 + a * r.dq, r.q0 + b * r.dq) for r, a, b, _ in level]
-            # an interval without an eroded target (the target moves further than its own
-            # thickness) is bounded by the eroded targets of its pieces where halving it k
-            # times gives them one (lazy rule; the previous rule bisects with samples)
-            split: dict[int, list] = {}
-            if self.lazy_samples:
-                for i, ((r, a, b, depth), (qa, qb)) in enumerate(zip(level, pairs, strict=True)):
-                    if self._eroded_core(qa, qb) is None:
-                        k = self._split_depth(b - a, depth, r.dq)
-                        if k is None or k > self.max_split:
-                            continue  # bisect with samples (or not at all, as before)
-                        ts = np.linspace(a, b, 2**k + 1)
-                        qs = [r.q0 + t * r.dq for t in ts]
-                        split[i] = list(zip(qs[:-1], qs[1:], strict=False))
-            self._prefetch_eroded(pairs + [p for ps in split.values() for p in ps])
+            pairs, split = self._birth_bounds(level)
+            self._prefetch([], pairs + [p for ps in split.values() for p in ps])
             todo, mids = [], []
             for i, (r, a, b, depth) in enumerate(level):
                 self._check_time()
@@ -1355,6 +1376,26 @@ class Sweeper:
                 r.frame(m)
                 r.stats["refined"] += 1
                 todo += [(r, a, m, depth + 1), (r, m, b, depth + 1)]
+
+    def _birth_bounds(self, level: list[tuple]) -> tuple[list, dict[int, list]]:
+        """For the intervals ``level`` ((run, a, b, depth) each) of the birth check: their
+        ends ``(qa, qb)``, and for those (by index) without an eroded target whose pieces
+        after ``k <= max_split`` halvings have one (lazy rule), the pieces' ends.  An interval
+        without an eroded target (the target moves further than its own thickness) is
+        bounded by the eroded targets of its pieces; the previous rule bisects it with
+        samples."""
+        pairs = [(r.q0 + a * r.dq, r.q0 + b * r.dq) for r, a, b, _ in level]
+        split: dict[int, list] = {}
+        if self.lazy_samples:
+            for i, ((r, a, b, depth), (qa, qb)) in enumerate(zip(level, pairs, strict=True)):
+                if self._eroded_core(qa, qb) is None:
+                    k = self._split_depth(b - a, depth, r.dq)
+                    if k is None or k > self.max_split:
+                        continue  # bisect with samples (or not at all, as before)
+                    ts = np.linspace(a, b, 2**k + 1)
+                    qs = [r.q0 + t * r.dq for t in ts]
+                    split[i] = list(zip(qs[:-1], qs[1:], strict=False))
+        return pairs, split
 
     def _born(
         self, upper: shapely.Geometry, sa: shapely.Geometry, sb: shapely.Geometry
@@ -1436,7 +1477,7 @@ class Sweeper:
     def _eroded_core(self, qa: np.ndarray, qb: np.ndarray) -> tuple | None:
         """The part of A common to all A_q, q in [qa, qb] (its largest piece) and its
         outline (clockwise), or None when it is empty (:meth:`_eroded_shadow`); kept per
-        interval (the batch of :meth:`_prefetch_eroded` and the check ask for the same)."""
+        interval (the batch of :meth:`_prefetch` and the check ask for the same)."""
         key = (tuple(qa.tolist()), tuple(qb.tolist()))
         cache = self.__dict__.setdefault("_cores", {})
         if key not in cache:
@@ -1458,25 +1499,6 @@ class Sweeper:
         core = parts[np.argmax(shapely.area(parts))]
         ring = np.asarray(shapely.orient_polygons(core, exterior_cw=True).exterior.coords)[:-1]
         return core, ring
-
-    def _prefetch_eroded(self, pairs: list[tuple[np.ndarray, np.ndarray]]) -> None:
-        """The weak visibility regions that :meth:`_eroded_shadow` needs for the intervals
-        ``pairs`` ((qa, qb) each), in one batch (:meth:`_prefetch`); kept until taken."""
-        todo = []
-        for qa, qb in pairs:
-            key = (tuple(qa.tolist()), tuple(qb.tolist()))
-            if key in self._eroded_pre:
-                continue
-            got = self._eroded_core(qa, qb)
-            if got is not None:
-                todo.append((key, got[1]))
-        if len(todo) < 2:
-            return
-        rings = [r for _, r in todo]
-        ones = [np.ones(len(r), dtype=bool) for r in rings]
-        regs = weak_visibility_many(self.env, rings, ones, self.eps_aim, self._anchors())
-        for (key, _), reg in zip(todo, regs, strict=True):
-            self._eroded_pre[key] = reg
 
     def _trace_many(self, edges: list, ta: float, tb: float, q0, dq) -> tuple[list, list]:
         """Areas swept by moving shadow edges found at sample ``ta`` while they live
@@ -2000,12 +2022,6 @@ def swept_shadows(
                 np.asarray(ring.coords)[:-1, :2], np.asarray(ring.coords)[1:, :2], strict=True
             )
         ]
-        # the samples at the vertices of the region's boundary in one batch (along() sets
-        # the same grazing mask)
-        with sw.clock("anchors"):
-            sw._grazing = sw._anchors()
-        with sw.clock("vertex samples"):
-            sw._prefetch([np.asarray(a, dtype=float) for a, _ in segs])
         done = [0]
 
         def traced(_: int) -> None:
