@@ -165,8 +165,10 @@ def test_skipping_fixed_edges_keeps_the_labels(monkeypatch) -> None:
 
 def test_batched_bisection_equals_step_by_step(monkeypatch) -> None:
     """The death-time bisection in rounds of several levels returns the times of the
-    bisection one step at a time (bit for bit), whatever the validity along the way."""
+    bisection one step at a time (bit for bit), whatever the validity along the way (the
+    previous rules: every step; the lazy rules stop early, see the next test)."""
     sw = _sweeper(monkeypatch)
+    sw.lazy_samples = False
     keys = [np.asarray(k) for k in sw._frames]
     moved = 0
     for q0, q1 in zip(keys[:-1], keys[1:], strict=True):
@@ -181,8 +183,9 @@ def test_batched_bisection_equals_step_by_step(monkeypatch) -> None:
             good = sw._valid_many(a, b, tm[:, None], q0, dq)[:, 0]
             t_ok = np.where(good, tm, t_ok)
             t_bad = np.where(good, t_bad, tm)
-        got = sw._bisect(edges, np.zeros(len(edges)), np.ones(len(edges)), q0, dq)
+        got, got_bad = sw._bisect(edges, np.zeros(len(edges)), np.ones(len(edges)), q0, dq)
         assert np.array_equal(got, t_ok)
+        assert np.array_equal(got_bad, t_bad)
         moved += int(((got > 0) & (got < 0.99)).sum())
     assert moved > 0  # not vacuous: some edges die inside the interval
 
@@ -287,7 +290,7 @@ def test_batched_weak_visibility_is_the_one_by_one_answer(monkeypatch) -> None:
         return orig(env, ring, wanted, eps, grazing)
 
     monkeypatch.setattr(S, "weak_visibility", record)
-    monkeypatch.setattr(S.Sweeper, "_prefetch", lambda self, qs: None)  # one by one here
+    monkeypatch.setattr(S.Sweeper, "_prefetch", lambda self, qs, eroded=(): None)  # one by one here
     lab = Scene.load("sensorplan_gym/scenes/lab.json")
     partial_region(lab, target_in="goal", theta=0.0)
     recognizable_region(Scene.load("sensorplan_gym/scenes/lab.json"), model="partial", theta=0.0)
@@ -354,3 +357,31 @@ def test_a_repeated_sweep_is_reused_on_the_same_scene_only(monkeypatch):
     seen = []
     partial_region(s, target_in="goal", theta=0.0, progress=lambda i, n: seen.append(i))
     assert len(calls) == 5 and seen
+
+
+def test_lazy_bisection_stops_once_the_ends_stand_still(monkeypatch) -> None:
+    """With the lazy rules an edge leaves the bisection once its ends move by at most tol / 4
+    between the last time found valid and the first found not: the bracket it returns still
+    holds the death (valid at t_ok, not at t_bad, or t_ok the start), is never wider than the
+    full bisection's first bracket that contains it, and either the ends stand still over
+    it or it is as narrow as all the steps make it."""
+    sw = _sweeper(monkeypatch)
+    keys = [np.asarray(k) for k in sw._frames]
+    early = 0
+    for q0, q1 in zip(keys[:-1], keys[1:], strict=True):
+        dq = q1 - q0
+        edges = sw._edges(*sw.shadow(q0))
+        if not edges or not np.hypot(*dq) > 0:
+            continue
+        zero, one = np.zeros(len(edges)), np.ones(len(edges))
+        sw.lazy_samples = False
+        full_ok, full_bad = sw._bisect(edges, zero, one, q0, dq)
+        sw.lazy_samples = True
+        t_ok, t_bad = sw._bisect(edges, zero, one, q0, dq)
+        assert ((t_ok <= full_ok) & (full_bad <= t_bad)).all()
+        a, b = sw._ends_many(edges, np.stack([t_ok, t_bad], axis=1), q0, dq)
+        still = sw._past_death(a[:, :1], b[:, :1], a[:, 1:], b[:, 1:])
+        narrow = (t_bad - t_ok) <= 2.0**-sw.bisect_steps
+        assert (still | narrow).all()
+        early += int((~narrow).sum())
+    assert early > 0  # not vacuous: some edges leave the bisection early

@@ -293,3 +293,37 @@ def test_events_from_the_corners_that_see_k_give_the_regions_of_every_corner(
             q0, q1 = np.asarray(q0), np.asarray(q1)
             assert len(sw._events(q0, q1 - q0)[0]) <= len(sw_every._events(q0, q1 - q0)[0])
         assert len(sw._event_corners()) <= int(sw.env.reflex.sum())
+
+
+def test_traces_carried_past_an_instant_death_need_no_sample(monkeypatch) -> None:
+    """``lse_arena``'s 5.2 query: on two edges of H a shadow edge changes neighbours at an
+    instant, so its traces from both ends of the edge of H stop one bisection step apart.  The
+    previous rules took that step for a configuration born and gone there and sampled it
+    (two refinements); the lazy rules carry each trace on to the first time found not valid
+    where its ends move by at most ``tol / 4`` (:meth:`~geometry.sweep.Sweeper._past_death`),
+    the traces meet, and the sweep takes no refinement.  The conservative regions agree."""
+    scene = load_scene("real/lse_arena")
+    kw = {"model": "partial", "theta": 0.0, "timeout": None, "conservative": True}
+    got = {}
+    for lazy in (True, False):
+        region, made = _with_rule(
+            lazy, lambda: recognizable_region(load_scene("real/lse_arena"), **kw), monkeypatch
+        )
+        got[lazy] = (region, [len(sw._frames) for sw in made])
+    assert sum(got[False][1]) >= sum(got[True][1]) + 2  # not vacuous: the step was sampled
+    tol = 1e-4 * scene.diameter
+    assert max(_depth(got[True][0], got[False][0]), _depth(got[False][0], got[True][0])) <= 2 * tol
+
+
+def test_a_trace_goes_past_its_death_only_by_a_quarter_of_tol() -> None:
+    """:meth:`~geometry.sweep.Sweeper._past_death` accepts ends that move by at most
+    ``tol / 4`` (both ends), never an end that is not finite."""
+    scene = load_scene("lab")
+    ring = ccw_ring(scene.target_at(0.0, 0.0, 0.0))
+    sw = S.Sweeper(scene_domain(scene), scene.free_space, ring, ring, None, 0.0, 1e-3)
+    a = np.zeros((4, 1, 2))
+    b = np.ones((4, 1, 2))
+    step = np.array([0.2e-3, 0.249e-3, 0.26e-3, np.nan])[:, None, None] * np.array([1.0, 0.0])
+    late = sw._past_death(a, b, a + step, b)
+    assert late.tolist() == [True, True, False, False]
+    assert sw._past_death(a, b, a, b + step).tolist() == [True, True, False, False]
