@@ -1143,8 +1143,7 @@ class Sweeper:
         known shadows and not traced, and the fan was missed (fuzz seed 203869: 3.5e-8 D²
         of shadow at a configuration between samples, kept in the ``conservative=True``
         region)."""
-        ts = self._grid(edges, min(t, toward), max(t, toward), q0, dq)
-        vs, ve = self._ends_many(edges, ts[None, :], q0, dq)  # (E, T, 2) each
+        _, vs, ve = self._grid(edges, min(t, toward), max(t, toward), q0, dq)  # (E, T, 2) each
         ring = np.concatenate([vs, ve[:, ::-1]], axis=1)
         ok = np.isfinite(ring).all(axis=(1, 2))
         polys = shapely.make_valid(shapely.polygons(np.where(ok[:, None, None], ring, 0.0)))
@@ -1505,8 +1504,7 @@ class Sweeper:
         between ``ta`` and ``tb``; returns ``(quads, end time reached per edge)``."""
         if not edges:
             return [], []
-        ts = self._grid(edges, ta, tb, q0, dq)
-        vs, ve = self._ends_many(edges, np.broadcast_to(ts, (len(edges), len(ts))), q0, dq)
+        ts, vs, ve = self._grid(edges, ta, tb, q0, dq)
         ok = self._valid_many(vs, ve, np.broadcast_to(ts, vs.shape[:2]), q0, dq)
         n_ok = np.where(ok.all(axis=1), len(ts), np.argmin(ok, axis=1))
         # bisect the death time of the edges that die inside the interval
@@ -1642,15 +1640,18 @@ class Sweeper:
             le[..., 0, :], le[..., 1, :], ln_[..., 0, :], ln_[..., 1, :]
         )
 
-    def _grid(self, edges: list, a: float, b: float, q0, dq) -> np.ndarray:
-        """Times from a to b so fine that the traced polylines stay within tol."""
+    def _grid(self, edges: list, a: float, b: float, q0, dq) -> tuple[np.ndarray, ...]:
+        """Times from a to b so fine that the traced polylines stay within tol, and the
+        ends of every edge at those times (:meth:`_ends_many`, (E, T, 2) each)."""
         n = 9
         while True:
             ts = np.linspace(a, b, n)
             mid = 0.5 * (ts[:-1] + ts[1:])
             err = 0.0
-            ends = self._ends_many(edges, ts[None, :], q0, dq)
-            mids = self._ends_many(edges, mid[None, :], q0, dq)
+            # the ends at the grid times and at the midpoints in one call (row by row)
+            both = self._ends_many(edges, np.concatenate([ts, mid])[None, :], q0, dq)
+            ends = [c[:, :n] for c in both]
+            mids = [c[:, n:] for c in both]
             for c, m in zip(ends, mids, strict=True):
                 chord = c[:, 1:] - c[:, :-1]
                 ln = np.hypot(chord[..., 0], chord[..., 1])
@@ -1659,7 +1660,7 @@ class Sweeper:
                 dev = dev[np.isfinite(dev)]
                 err = max(err, float(dev.max()) if len(dev) else 0.0)
             if err <= self.tol or n >= 257:
-                return ts
+                return ts, ends[0], ends[1]
             n = 2 * n - 1
 
     def _between_lines(self, vs: np.ndarray, d: np.ndarray, ts: np.ndarray, q0, dq) -> np.ndarray:
@@ -1872,18 +1873,26 @@ def _drop_short(
     of some (k, 2), the environment vertex it is at, or -1 (see :func:`_corners`)."""
     if len(v) == 0:
         return v
-    step = np.abs(np.diff(v, axis=0)).max(axis=1) >= length
-    if step.all():  # no short edge inside: every vertex is kept (the loop below agrees)
-        keep = list(range(len(v)))
-    else:
-        keep = [0]
-        long_step = step.tolist()  # right after a kept vertex the test is the step's
-        for i in range(1, len(v)):
-            if keep[-1] == i - 1:
-                if long_step[i - 1]:
-                    keep.append(i)
-            elif np.abs(v[i] - v[keep[-1]]).max() >= length:
-                keep.append(i)
+    # vertex i is kept iff it lies at least ``length`` (max-norm) from the last kept one;
+    # after a kept vertex that is its step's length, so the runs of long steps are kept
+    # whole and only the vertices after a short step are compared one by one
+    n = len(v)
+    short = np.flatnonzero(np.abs(np.diff(v, axis=0)).max(axis=1) < length)
+    keep = [0]
+    i = 1  # the next vertex to decide; vertex i - 1 is kept
+    for s in short:
+        if s < i - 1:
+            continue  # a short step inside a cluster already dropped
+        keep.extend(range(i, s + 1))  # long steps from i - 1 to s
+        j = s + 2  # v[s + 1] lies within length of v[s]: dropped, and so are the next
+        while j < n and np.abs(v[j] - v[s]).max() < length:
+            j += 1
+        if j < n:
+            keep.append(j)
+        i = j + 1
+        if i >= n:
+            break
+    keep.extend(range(i, n))
     tail = len(v)  # the vertices from ``tail`` on join vertex 0's cluster (the ring closes)
     while len(keep) > 1 and np.abs(v[keep[-1]] - v[0]).max() < length:
         tail = keep.pop()
@@ -1916,16 +1925,17 @@ def _corners(
     on its other side off its line by the short edge's length, unlabelled, and its
     moving neighbour dropped from the tracing."""
     n = len(v)
-    out: list[np.ndarray] = []
-    ends = keep[1:] + [tail]
-    for j, (k, nxt) in enumerate(zip(keep, ends, strict=True)):
-        first = tail % n if j == 0 and tail < n else k  # the cluster's first vertex
-        last = nxt - 1  # and its last
-        out.append(v[k])
-        if first == last:
-            continue
-        a0, a1 = v[first - 1], v[first]
-        b0, b1 = v[last], v[(last + 1) % n]
+    kept = np.asarray(keep)
+    first = kept.copy()  # each cluster's first vertex (vertex 0's: from ``tail`` on)
+    if tail < n:
+        first[0] = tail % n
+    last = np.append(kept[1:], tail) - 1  # and its last
+    pts = v[kept].copy()
+    extra: dict[int, np.ndarray] = {}  # a second vertex after pts[j]
+    for j in np.flatnonzero(first != last).tolist():
+        f, lt, k = int(first[j]), int(last[j]), int(kept[j])
+        a0, a1 = v[f - 1], v[f]
+        b0, b1 = v[lt], v[(lt + 1) % n]
         da, db = a1 - a0, b1 - b0
         den = float(da[0] * db[1] - da[1] * db[0])
         c = np.full(2, np.inf)
@@ -1933,14 +1943,21 @@ def _corners(
             u = float((b0[0] - a0[0]) * db[1] - (b0[1] - a0[1]) * db[0]) / den
             c = a0 + u * da
         if np.isfinite(c).all() and np.abs(c - v[k]).max() <= 4.0 * length:
-            out[-1] = c
+            pts[j] = c
         elif vertex_at is not None:
-            idx = np.arange(first, first + (last - first) % n + 1) % n
+            idx = np.arange(f, f + (lt - f) % n + 1) % n
             at = vertex_at(v[idx])
             env = np.flatnonzero(at >= 0)
             if len(env) and (at[env] != at[env[0]]).any():
-                out[-1] = v[idx[env[0]]]
-                out.append(v[idx[env[at[env] != at[env[0]]][-1]]])
+                pts[j] = v[idx[env[0]]]
+                extra[j] = v[idx[env[at[env] != at[env[0]]][-1]]]
+    if not extra:
+        return pts
+    out: list[np.ndarray] = []
+    for j in range(len(pts)):
+        out.append(pts[j])
+        if j in extra:
+            out.append(extra[j])
     return np.asarray(out)
 
 

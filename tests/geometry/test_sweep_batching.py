@@ -385,3 +385,35 @@ def test_lazy_bisection_stops_once_the_ends_stand_still(monkeypatch) -> None:
         assert (still | narrow).all()
         early += int((~narrow).sum())
     assert early > 0  # not vacuous: some edges leave the bisection early
+
+
+def _drop_short_definition(v: np.ndarray, length: float) -> list[int]:
+    """The vertices :func:`geometry.sweep._drop_short` keeps, one by one: vertex i when it
+    lies at least ``length`` (max-norm) from the last kept vertex."""
+    keep = [0]
+    for i in range(1, len(v)):
+        if np.abs(v[i] - v[keep[-1]]).max() >= length:
+            keep.append(i)
+    return keep
+
+
+def test_drop_short_keeps_the_vertices_of_its_definition() -> None:
+    """The run-skipping scan of ``_drop_short`` keeps the vertices of the one-by-one
+    definition (then closes the ring and moves each kept vertex to its cluster's corner as
+    before): bit for bit on 5,000 random rings, a third of their steps short."""
+    rng = np.random.default_rng(7)
+    length = 1e-2
+    clustered = 0
+    for _ in range(5000):
+        n = int(rng.integers(1, 30))
+        steps = rng.normal(size=(n, 2)) * np.where(rng.random((n, 1)) < 0.35, 1e-3, 1.0)
+        v = np.cumsum(steps, axis=0)
+        keep = _drop_short_definition(v, length)
+        tail = len(v)
+        while len(keep) > 1 and np.abs(v[keep[-1]] - v[0]).max() < length:
+            tail = keep.pop()
+        want = v if len(keep) == len(v) else S._corners(v, keep, tail, length)
+        got = S._drop_short(v, length)
+        assert got.shape == want.shape and np.array_equal(got, want)
+        clustered += len(keep) < len(v)
+    assert clustered > 1000  # not vacuous: most rings have clusters
