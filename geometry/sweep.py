@@ -1934,16 +1934,23 @@ def _corners(
     extra: dict[int, np.ndarray] = {}  # a second vertex after pts[j]
     for j in np.flatnonzero(first != last).tolist():
         f, lt, k = int(first[j]), int(last[j]), int(kept[j])
-        a0, a1 = v[f - 1], v[f]
-        b0, b1 = v[lt], v[(lt + 1) % n]
-        da, db = a1 - a0, b1 - b0
-        den = float(da[0] * db[1] - da[1] * db[0])
-        c = np.full(2, np.inf)
+        # the two lines' crossing in Python floats (the same IEEE operations as numpy's
+        # element by element, without its per-scalar overhead)
+        (a0x, a0y), (a1x, a1y) = v[f - 1].tolist(), v[f].tolist()
+        (b0x, b0y), (b1x, b1y) = v[lt].tolist(), v[(lt + 1) % n].tolist()
+        dax, day, dbx, dby = a1x - a0x, a1y - a0y, b1x - b0x, b1y - b0y
+        den = dax * dby - day * dbx
+        cx = cy = math.inf
         if den != 0.0:
-            u = float((b0[0] - a0[0]) * db[1] - (b0[1] - a0[1]) * db[0]) / den
-            c = a0 + u * da
-        if np.isfinite(c).all() and np.abs(c - v[k]).max() <= 4.0 * length:
-            pts[j] = c
+            u = ((b0x - a0x) * dby - (b0y - a0y) * dbx) / den
+            cx, cy = a0x + u * dax, a0y + u * day
+        vx, vy = v[k].tolist()
+        if (
+            math.isfinite(cx)
+            and math.isfinite(cy)
+            and max(abs(cx - vx), abs(cy - vy)) <= 4.0 * length
+        ):
+            pts[j] = (cx, cy)
         elif vertex_at is not None:
             idx = np.arange(f, f + (lt - f) % n + 1) % n
             at = vertex_at(v[idx])
