@@ -233,6 +233,11 @@ class Sweeper:
         self.hull = np.asarray(self.hull, dtype=float)
         self.n_fixed = len(self.env.vert)
         self.m = len(self.ring0)
+        #: a convex target: A_qa n A_qb is then common to every A_q in between (no edge
+        #: sweeps over it, :meth:`_eroded_core_of`)
+        e0 = np.roll(self.ring0, -1, axis=0) - self.ring0
+        turn = _cross(e0, np.roll(e0, -1, axis=0))
+        self._convex = bool((turn >= 0).all() or (turn <= 0).all())
         self.edge0 = np.roll(self.ring0, -1, axis=0) - self.ring0
         segs, owner = [np.zeros((0, 4))], [np.zeros(0, dtype=int)]
         if self.strips is not None:
@@ -1487,11 +1492,14 @@ class Sweeper:
         aa = shapely.Polygon(self.ring0 + qa)
         ab = shapely.Polygon(self.ring0 + qb)
         core = shapely.intersection(aa, ab)
-        r = self.ring0 + qa
-        e = np.roll(r, -1, axis=0)
-        d = qb - qa
-        par = shapely.polygons(np.stack([r, e, e + d, r + d], axis=1))
-        core = polygonal(shapely.difference(core, union_all(par)))
+        if not self._convex:
+            # a point of A_qa n A_qb that an edge sweeps over in between leaves A_q there
+            r = self.ring0 + qa
+            e = np.roll(r, -1, axis=0)
+            d = qb - qa
+            par = shapely.polygons(np.stack([r, e, e + d, r + d], axis=1))
+            core = shapely.difference(core, union_all(par))
+        core = polygonal(core)
         if core.is_empty:
             return None
         parts = shapely.get_parts(core)

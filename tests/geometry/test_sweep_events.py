@@ -327,3 +327,30 @@ def test_a_trace_goes_past_its_death_only_by_a_quarter_of_tol() -> None:
     late = sw._past_death(a, b, a + step, b)
     assert late.tolist() == [True, True, False, False]
     assert sw._past_death(a, b, a, b + step).tolist() == [True, True, False, False]
+
+
+def test_a_convex_targets_eroded_part_is_the_intersection_of_the_ends() -> None:
+    """For a convex target the part common to every A_q along a segment is A_qa n A_qb (the
+    edges' swept parallelograms take nothing from it), so the sweeper skips subtracting them;
+    for a non-convex one they do take a part (an L whose notch an arm sweeps through)."""
+    scene = load_scene("lab")
+    rng = np.random.default_rng(3)
+    for _ in range(40):
+        pts = rng.normal(size=(7, 2))
+        ring = ccw_ring(shapely.convex_hull(shapely.multipoints(pts)))
+        sw = S.Sweeper(scene_domain(scene), scene.free_space, ring, ring, None, 0.0, 1e-3)
+        assert sw._convex
+        qa, qb = rng.normal(size=2) * 0.1, rng.normal(size=2) * 0.4
+        fast = sw._eroded_core_of(qa, qb)
+        sw._convex = False
+        full = sw._eroded_core_of(qa, qb)
+        assert (fast is None) == (full is None)
+        if fast is not None:
+            assert shapely.symmetric_difference(fast[0], full[0]).area <= 1e-12 * full[0].area
+    ell = np.array([[0, 0], [2, 0], [2, 0.5], [0.5, 0.5], [0.5, 2], [0, 2]], dtype=float)
+    sw = S.Sweeper(scene_domain(scene), scene.free_space, ell, ell, None, 0.0, 1e-3)
+    assert not sw._convex
+    got = sw._eroded_core_of(np.zeros(2), np.array([-1.0, 1.0]))
+    both = shapely.intersection(shapely.Polygon(ell), shapely.Polygon(ell + [-1.0, 1.0]))
+    assert both.area > 0.1  # the ends overlap ...
+    assert got is None or got[0].area < both.area - 1e-6  # ... but the notch sweeps over it
