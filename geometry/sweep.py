@@ -71,7 +71,7 @@ from ._shapes import cross as _cross
 from ._vis import TAU, Domain, RayEscapeError, gaps_many
 from .weak import ENV as _ENV
 from .weak import WANTED as _WANTED
-from .weak import weak_visibility, weak_visibility_many
+from .weak import corners_seeing, weak_visibility, weak_visibility_many
 
 #: The union of the pieces is snap-rounded onto a grid of ``2**-GRID_BITS`` of the scene's
 #: size (about 1e-12): see :func:`swept_shadows`.
@@ -1757,11 +1757,19 @@ class Sweeper:
             got = np.zeros(len(env.vert), dtype=bool)
             idx = np.flatnonzero(env.reflex)
             if len(idx):
-                ring = self.hull[::-1]  # clockwise: a hole of the domain
-                seen = weak_visibility(env, ring, np.ones(len(ring), dtype=bool))
-                seen = shapely.union(seen, self._hull_poly)
-                pts = shapely.points(env.vert[idx])
-                got[idx] = shapely.dwithin(seen, pts, 1e-6 * env.scale)
+                if self.lazy_samples:
+                    # the corners whose rays towards K reach it (no fans, no union)
+                    got = corners_seeing(env, self.hull[::-1])
+                    near = shapely.dwithin(
+                        self._hull_poly, shapely.points(env.vert[idx]), 1e-6 * env.scale
+                    )
+                    got[idx[near]] = True
+                else:
+                    ring = self.hull[::-1]  # clockwise: a hole of the domain
+                    seen = weak_visibility(env, ring, np.ones(len(ring), dtype=bool))
+                    seen = shapely.union(seen, self._hull_poly)
+                    pts = shapely.points(env.vert[idx])
+                    got[idx] = shapely.dwithin(seen, pts, 1e-6 * env.scale)
             self._anchor_mask = got
         return got
 

@@ -147,14 +147,45 @@ def _front(
     return front
 
 
+def corners_seeing(env: Domain, ring: np.ndarray) -> np.ndarray:
+    """(len(env.vert),) bool: the reflex vertices of ``env`` (convex obstacle corners) that
+    see a point of the target outline ``ring`` (clockwise, every edge wanted) under a
+    positive angle: the candidates of :func:`weak_visibility`'s step 2 whose rays, cast in
+    their sector towards the target (the target a hole that occludes), first hit it in
+    some gap.  A corner that sees a target held by this one (``A_q`` inside the region
+    ``ring`` bounds, obstacle-free) under a positive angle sees this one so too: the rays
+    that reach ``A_q`` first enter the region.  So these are the only corners that can be
+    grazing anchors of such a target (``weak_visibility``'s ``grazing``), found without
+    building the region's fans and their union."""
+    out = np.zeros(len(env.vert), dtype=bool)
+    wanted = np.ones(len(ring), dtype=bool)
+    ring, wanted = snap_to_boundary(env, ring, wanted)
+    dom = env.with_ring(ring, UNWANTED, np.where(wanted, WANTED, UNWANTED))
+    nv = len(env.vert)
+    grz = _grazing_anchors(ring, dom, None, nv)
+    if grz is None:
+        return out
+    idx = _grazing_anchors(ring, dom, None, nv, index=True)
+    v, sectors, extra, arcs = grz
+    g, off = gaps_many(dom, v, sectors=sectors, extra=extra, flat=True)
+    sees = (g.seg >= 0) & (dom.seg_tag[np.maximum(g.seg, 0)] == WANTED)
+    owner = np.searchsorted(off, np.arange(len(g.lo)), side="right") - 1
+    if arcs is not None:
+        sees &= _grazes(arcs[owner], 0.5 * (g.lo + g.hi))
+    sel = idx[np.bincount(owner[sees], minlength=len(v)) > 0]
+    out[sel[sel < nv]] = True
+    return out
+
+
 def _grazing_anchors(
-    ring: np.ndarray, dom: Domain, grazing: np.ndarray | None, nv: int
-) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, np.ndarray | None] | None:
+    ring: np.ndarray, dom: Domain, grazing: np.ndarray | None, nv: int, index: bool = False
+) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, np.ndarray | None] | np.ndarray | None:
     """Step 2 of :func:`weak_visibility`: the grazing anchors (reflex vertices of ``dom``,
-    those of the free space's ``nv`` first ones filtered by ``grazing``) that see the
-    target under a positive angle, with their sectors ``(start, width)`` (radians)
-    towards it, the extra critical directions of their pinch arcs (or None) and the arcs
-    (or None).  None when ``dom`` has no candidate vertex at all."""
+    those of the free space's ``nv`` first ones filtered by ``grazing``) whose sector
+    towards the target has a positive angle, with their sectors ``(start, width)``
+    (radians), the extra critical directions of their pinch arcs (or None) and the arcs
+    (or None); ``index=True``: only their indices into ``dom.vert``.  None when ``dom``
+    has no candidate vertex at all."""
     v_idx = np.flatnonzero(dom.reflex)
     if grazing is not None:
         v_idx = v_idx[(v_idx >= nv) | grazing[np.minimum(v_idx, nv - 1)]]
@@ -170,6 +201,8 @@ def _grazing_anchors(
     hi = np.where(on_target, -np.inf, rel).max(axis=1)
     ok = hi - lo > 1e-12
     v, sectors = v[ok], np.stack([base[ok] + lo[ok], hi[ok] - lo[ok]], axis=1)
+    if index:
+        return v_idx[ok]
     # a line through a pinch (polygons touching at v) passes between them: blocked
     arcs = _pinch_arcs(dom, v_idx[ok])
     extra = None

@@ -4,6 +4,7 @@ definitions (issue 25 item 1: speed without changing answers)."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 import shapely
 
 from geometry import Scene, partial_region, recognizable_region
@@ -417,3 +418,36 @@ def test_drop_short_keeps_the_vertices_of_its_definition() -> None:
         assert got.shape == want.shape and np.array_equal(got, want)
         clustered += len(keep) < len(v)
     assert clustered > 1000  # not vacuous: most rings have clusters
+
+
+@pytest.mark.parametrize("name", ["sensorplan_gym/scenes/lab.json", "real/heidelberg_l1"])
+def test_corners_that_see_k_are_those_inside_its_weak_visibility_region(name, monkeypatch) -> None:
+    """``Sweeper._anchors`` (lazy rules) takes the corners whose rays towards K reach it
+    (``weak.corners_seeing``) instead of the corners within 1e-6 of K's weak visibility
+    region (the previous rules): none outside that region, and the ones it leaves out lie on
+    the region's boundary (a ray grazing them, no positive angle of K in sight); the
+    sweep's shadows with either mask are the same (above)."""
+    from sensorplan_gym.core.scenes import load_scene
+
+    scene = Scene.load(name) if name.endswith(".json") else load_scene(name)
+    got = {}
+    orig = S.Sweeper.along_many
+
+    def along_many(self, *a, **k):
+        got.setdefault("sw", self)
+        return orig(self, *a, **k)
+
+    monkeypatch.setattr(S.Sweeper, "along_many", along_many)
+    partial_region(scene, target_in="goal", theta=0.0)
+    sw = got["sw"]
+    new = sw._anchors()
+    del sw._anchor_mask
+    sw.lazy_samples = False
+    old = sw._anchors()
+    assert new.sum() > 0 and not (new & ~old).any()
+    ring = sw.hull[::-1]
+    seen = shapely.union(
+        S.weak_visibility(sw.env, ring, np.ones(len(ring), dtype=bool)), sw._hull_poly
+    )
+    left = shapely.points(sw.env.vert[old & ~new])
+    assert (shapely.distance(seen.boundary, left) <= 1e-6 * sw.env.scale).all()
