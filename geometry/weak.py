@@ -71,7 +71,7 @@ def weak_visibility(
     #    first the directions in which v sees a wanted piece ...
     grz = _grazing_anchors(ring, dom, grazing, len(env.vert))
     if grz is not None:
-        v, sectors, extra, arcs = grz
+        v, sectors, extra, arcs, _ = grz
         g, off = gaps_many(dom, v, sectors=sectors, extra=extra, flat=True)
         sees = (g.seg >= 0) & (dom.seg_tag[np.maximum(g.seg, 0)] == WANTED)
         if arcs is not None:
@@ -165,8 +165,7 @@ def corners_seeing(env: Domain, ring: np.ndarray) -> np.ndarray:
     grz = _grazing_anchors(ring, dom, None, nv)
     if grz is None:
         return out
-    idx = _grazing_anchors(ring, dom, None, nv, index=True)
-    v, sectors, extra, arcs = grz
+    v, sectors, extra, arcs, idx = grz
     g, off = gaps_many(dom, v, sectors=sectors, extra=extra, flat=True)
     sees = (g.seg >= 0) & (dom.seg_tag[np.maximum(g.seg, 0)] == WANTED)
     owner = np.searchsorted(off, np.arange(len(g.lo)), side="right") - 1
@@ -178,14 +177,14 @@ def corners_seeing(env: Domain, ring: np.ndarray) -> np.ndarray:
 
 
 def _grazing_anchors(
-    ring: np.ndarray, dom: Domain, grazing: np.ndarray | None, nv: int, index: bool = False
-) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, np.ndarray | None] | np.ndarray | None:
+    ring: np.ndarray, dom: Domain, grazing: np.ndarray | None, nv: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray | None, np.ndarray | None, np.ndarray] | None:
     """Step 2 of :func:`weak_visibility`: the grazing anchors (reflex vertices of ``dom``,
     those of the free space's ``nv`` first ones filtered by ``grazing``) whose sector
     towards the target has a positive angle, with their sectors ``(start, width)``
-    (radians), the extra critical directions of their pinch arcs (or None) and the arcs
-    (or None); ``index=True``: only their indices into ``dom.vert``.  None when ``dom``
-    has no candidate vertex at all."""
+    (radians), the extra critical directions of their pinch arcs (or None), the arcs
+    (or None) and their indices into ``dom.vert``.  None when ``dom`` has no candidate
+    vertex at all."""
     v_idx = np.flatnonzero(dom.reflex)
     if grazing is not None:
         v_idx = v_idx[(v_idx >= nv) | grazing[np.minimum(v_idx, nv - 1)]]
@@ -201,15 +200,13 @@ def _grazing_anchors(
     hi = np.where(on_target, -np.inf, rel).max(axis=1)
     ok = hi - lo > 1e-12
     v, sectors = v[ok], np.stack([base[ok] + lo[ok], hi[ok] - lo[ok]], axis=1)
-    if index:
-        return v_idx[ok]
     # a line through a pinch (polygons touching at v) passes between them: blocked
     arcs = _pinch_arcs(dom, v_idx[ok])
     extra = None
     if arcs is not None:  # split the gaps where a line through v starts to separate
         a0, a1 = arcs[..., 0], arcs[..., 0] + arcs[..., 1]
         extra = np.concatenate([a0, a1, a0 - np.pi, a1 - np.pi], axis=1)
-    return v, sectors, extra, arcs
+    return v, sectors, extra, arcs, v_idx[ok]
 
 
 def _pinch_arcs(dom: Domain, idx: np.ndarray) -> np.ndarray | None:
@@ -611,7 +608,7 @@ def weak_visibility_many(
         if grz is None:
             meta2.append(None)
             continue
-        v, sectors, extra, arcs = grz
+        v, sectors, extra, arcs, _ = grz
         q2.append(v)
         s2.append(sectors)
         e2.append(extra if extra is not None else np.zeros((len(v), 0)))
