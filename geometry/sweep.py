@@ -435,22 +435,27 @@ class Sweeper:
         all_keys = np.full((len(flat), 2), -1, dtype=np.int64)
         if need.any():
             all_keys[need] = self._label(flat[need], table, tid, d=d[need])
-        for r in range(len(vs)):
-            keys = all_keys[off[r] : off[r + 1]]
-            # consecutive edges on one line (the same key) are one shadow edge: the overlay
-            # can leave a vertex inside an edge (a node of another ring, a hot pixel), and
-            # its pieces would each see their own line as a neighbour and be dropped below
-            # (a shadow traced in one frame and missed in another, fuzz seed 8103)
-            same = (keys == np.roll(keys, 1, axis=0)).all(axis=1) & (keys >= 0).all(axis=1)
-            if same.all():
-                continue
-            keys = keys[~same]
-            moving = (keys >= n).any(axis=1) & (keys >= 0).all(axis=1)
-            for i in np.flatnonzero(moving):
-                kp, kn = keys[i - 1], keys[(i + 1) % len(keys)]
-                if min(kp) < 0 or min(kn) < 0 or set(kp) == set(keys[i]) or set(kn) == set(keys[i]):
-                    continue
-                out.append((tuple(kp), tuple(keys[i]), tuple(kn)))
+        # consecutive edges on one line (the same key) are one shadow edge: the overlay can
+        # leave a vertex inside an edge (a node of another ring, a hot pixel), and its pieces
+        # would each see their own line as a neighbour and be dropped below (a shadow traced
+        # in one frame and missed in another, fuzz seed 8103); a ring all of one line holds
+        # none.  All rings at once; the keys are sorted pairs, so equal lines are equal rows.
+        same = (all_keys == all_keys[prv]).all(axis=1) & (all_keys >= 0).all(axis=1)
+        kept = np.flatnonzero(~same & ~np.logical_and.reduceat(same, off[:-1])[ring_of])
+        if not len(kept):
+            return out
+        kr = ring_of[kept]
+        pos = np.arange(len(kept))
+        first = np.searchsorted(kr, kr, side="left")  # the ring's first and last kept edge
+        last = np.searchsorted(kr, kr, side="right") - 1
+        keys = all_keys[kept]
+        kp = keys[np.where(pos == first, last, pos - 1)]  # neighbours along the ring
+        kn = keys[np.where(pos == last, first, pos + 1)]
+        moving = (keys >= n).any(axis=1) & (keys >= 0).all(axis=1)
+        ok = moving & (kp >= 0).all(axis=1) & (kn >= 0).all(axis=1)
+        ok &= ~(kp == keys).all(axis=1) & ~(kn == keys).all(axis=1)
+        for j in np.flatnonzero(ok):
+            out.append((tuple(kp[j]), tuple(keys[j]), tuple(kn[j])))
         return out
 
     def _fixed_edges(self, v: np.ndarray, off: np.ndarray) -> np.ndarray:
