@@ -35,7 +35,8 @@ def test_drop_short_matches_the_loop() -> None:
         assert int((np.abs(got - ref) > 0).any(axis=1).sum()) <= k
 
 
-def _sweeper(monkeypatch) -> S.Sweeper:
+def _sweeper(monkeypatch, scene: Scene | None = None) -> S.Sweeper:
+    """The sweeper of the swept partial query over G on ``scene`` (default ``lab``)."""
     got = {}
     orig = S.Sweeper.along_many
 
@@ -44,7 +45,8 @@ def _sweeper(monkeypatch) -> S.Sweeper:
         return orig(self, *a, **k)
 
     monkeypatch.setattr(S.Sweeper, "along_many", along_many)
-    partial_region(Scene.load("sensorplan_gym/scenes/lab.json"), target_in="goal", theta=0.0)
+    scene = scene or Scene.load("sensorplan_gym/scenes/lab.json")
+    partial_region(scene, target_in="goal", theta=0.0)
     return got["sw"]
 
 
@@ -164,19 +166,24 @@ def test_skipping_fixed_edges_keeps_the_labels(monkeypatch) -> None:
     assert skipped > 0
 
 
+def _moving_edges(sw: S.Sweeper):
+    """``(q0, dq, edges)`` between consecutive samples of ``sw``: the shadow edges on moving
+    lines at ``q0`` and the step to the next sample (where both exist)."""
+    keys = [np.asarray(k) for k in sw._frames]
+    for q0, q1 in zip(keys[:-1], keys[1:], strict=True):
+        edges = sw._edges(*sw.shadow(q0))
+        if edges and np.hypot(*(q1 - q0)) > 0:
+            yield q0, q1 - q0, edges
+
+
 def test_batched_bisection_equals_step_by_step(monkeypatch) -> None:
     """The death-time bisection in rounds of several levels returns the times of the
     bisection one step at a time (bit for bit), whatever the validity along the way (the
     previous rules: every step; the lazy rules stop early, see the next test)."""
     sw = _sweeper(monkeypatch)
     sw.lazy_samples = False
-    keys = [np.asarray(k) for k in sw._frames]
     moved = 0
-    for q0, q1 in zip(keys[:-1], keys[1:], strict=True):
-        dq = q1 - q0
-        edges = sw._edges(*sw.shadow(q0))
-        if not edges or not np.hypot(*dq) > 0:
-            continue
+    for q0, dq, edges in _moving_edges(sw):
         t_ok, t_bad = np.zeros(len(edges)), np.ones(len(edges))
         for _ in range(sw.bisect_steps):  # the definition
             tm = 0.5 * (t_ok + t_bad)
@@ -367,13 +374,8 @@ def test_lazy_bisection_stops_once_the_ends_stand_still(monkeypatch) -> None:
     full bisection's first bracket that contains it, and either the ends stand still over
     it or it is as narrow as all the steps make it."""
     sw = _sweeper(monkeypatch)
-    keys = [np.asarray(k) for k in sw._frames]
     early = 0
-    for q0, q1 in zip(keys[:-1], keys[1:], strict=True):
-        dq = q1 - q0
-        edges = sw._edges(*sw.shadow(q0))
-        if not edges or not np.hypot(*dq) > 0:
-            continue
+    for q0, dq, edges in _moving_edges(sw):
         zero, one = np.zeros(len(edges)), np.ones(len(edges))
         sw.lazy_samples = False
         full_ok, full_bad = sw._bisect(edges, zero, one, q0, dq)
@@ -430,16 +432,7 @@ def test_corners_that_see_k_are_those_inside_its_weak_visibility_region(name, mo
     from sensorplan_gym.core.scenes import load_scene
 
     scene = Scene.load(name) if name.endswith(".json") else load_scene(name)
-    got = {}
-    orig = S.Sweeper.along_many
-
-    def along_many(self, *a, **k):
-        got.setdefault("sw", self)
-        return orig(self, *a, **k)
-
-    monkeypatch.setattr(S.Sweeper, "along_many", along_many)
-    partial_region(scene, target_in="goal", theta=0.0)
-    sw = got["sw"]
+    sw = _sweeper(monkeypatch, scene)
     new = sw._anchors()
     del sw._anchor_mask
     sw.lazy_samples = False
