@@ -1497,7 +1497,7 @@ class Sweeper:
         aa = shapely.Polygon(self.ring0 + qa)
         ab = shapely.Polygon(self.ring0 + qb)
         core = shapely.intersection(aa, ab)
-        if not self._convex:
+        if not (self._convex and self.lazy_samples):  # the previous rules: as they were
             # a point of A_qa n A_qb that an edge sweeps over in between leaves A_q there
             r = self.ring0 + qa
             e = np.roll(r, -1, axis=0)
