@@ -233,12 +233,11 @@ class Sweeper:
         self.hull = np.asarray(self.hull, dtype=float)
         self.n_fixed = len(self.env.vert)
         self.m = len(self.ring0)
+        self.edge0 = np.roll(self.ring0, -1, axis=0) - self.ring0
         #: a convex target: A_qa n A_qb is then common to every A_q in between (no edge
         #: sweeps over it, :meth:`_eroded_core_of`)
-        e0 = np.roll(self.ring0, -1, axis=0) - self.ring0
-        turn = _cross(e0, np.roll(e0, -1, axis=0))
+        turn = _cross(self.edge0, np.roll(self.edge0, -1, axis=0))
         self._convex = bool((turn >= 0).all() or (turn <= 0).all())
-        self.edge0 = np.roll(self.ring0, -1, axis=0) - self.ring0
         segs, owner = [np.zeros((0, 4))], [np.zeros(0, dtype=int)]
         if self.strips is not None:
             for i, u in enumerate(self.strips):
