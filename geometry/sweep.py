@@ -778,7 +778,10 @@ class Sweeper:
                     run.frame(t)
         if moving:
             with clock("birth checks"):
-                self._refine_births_many(moving, [ts_all[runs.index(r)] for r in moving])
+                # the first level is the one whose bounds the vertex batch computed
+                self._refine_births_many(
+                    moving, [ts_all[runs.index(r)] for r in moving], (pairs, split)
+                )
         # the collinearity events (shadows born on a line) are sampled lazily: once
         # between consecutive events next to a *live* event, one whose wedge's lines carry
         # a shadow edge at a sample so far (see _live_mids), until no new one is live;
@@ -1337,7 +1340,9 @@ class Sweeper:
                 return 0.5 * (reach + b)
         return None
 
-    def _refine_births_many(self, runs: list[_Run], ts_all: list[list]) -> None:
+    def _refine_births_many(
+        self, runs: list[_Run], ts_all: list[list], first: tuple | None = None
+    ) -> None:
         """Add sample times (to each run's frames) where the eroded target's shadow has a
         component that neither neighbouring sample's shadow meets (a shadow born and dying in
         between, :meth:`_born`); bisect up to ``max_depth`` times.  An interval without an
@@ -1351,7 +1356,8 @@ class Sweeper:
         shadows, which the 5.2 shadows contain, so a shadow of the full target born in
         between is caught here too (and the 5.2 region stays inside R(G); fuzz seed 411063,
         mixed G/H).  Births of shadows that exist only because pieces are unwanted are not
-        detected by it.  ``runs``: the segments, ``ts_all``: their sample times so far."""
+        detected by it.  ``runs``: the segments, ``ts_all``: their sample times so far;
+        ``first``: :meth:`_birth_bounds` of the first level when the caller has it."""
         todo = [
             (r, a, b, 0)
             for r, ts in zip(runs, ts_all, strict=True)
@@ -1363,7 +1369,8 @@ class Sweeper:
         while todo:
             self._check_time()
             level = [(r, a, b, depth) for r, a, b, depth in todo if depth < self.max_depth]
-            pairs, split = self._birth_bounds(level)
+            pairs, split = first if first is not None else self._birth_bounds(level)
+            first = None
             self._prefetch([], pairs + [p for ps in split.values() for p in ps])
             todo, mids = [], []
             for i, (r, a, b, depth) in enumerate(level):
