@@ -888,26 +888,23 @@ class Sweeper:
         from one call to the next."""
         dq = q1 - q0
         cover, confirmed, traced, probed = state.cover, state.confirmed, state.traced, state.probed
+        pre: dict[tuple[float, float], list] = {}  # interval -> its traces, both ways
         while todo:
             self._check_time()
+            if (todo[-1][0], todo[-1][1]) not in pre:
+                # the traces of every interval waiting, in one batch (a trace depends only
+                # on its interval's two samples, not on what the others covered)
+                wait = [(a_, b_) for a_, b_, _ in todo if (a_, b_) not in pre]
+                pre.update(self._interval_traces(wait, q0, q1, frame))
             a, b, depth = todo.pop()
-            # the areal part: GEOS's union of two nearly coincident shadows can carry
-            # collapsed edges (LineStrings), and an overlay with such a collection fails
-            # ("Result area inconsistent with overlay operation", fuzz seed 501057)
-            known = None  # the shadows' union, only if their X (see _uncovered_seen) is not kept
             cut: list[tuple] = []  # (edge, t_end, toward): traces ended by a neighbour's change
-            for t, toward in ((a, b), (b, a)):
-                edges = self._uncovered_seen(frame(t)[1], t, toward, (a, b), q0, q1)
-                if edges is None:
-                    if known is None:
-                        known = areal(shapely.union(frame(a)[0], frame(b)[0]))
-                    edges = self._uncovered(frame(t)[1], t, toward, known, q0, dq)
+            done = pre.pop((a, b))
+            for (t, toward), (edges, quads, ends) in zip(((a, b), (b, a)), done, strict=True):
                 inside = [e for e in frame(t)[1] if e not in edges]
                 for e in inside:  # swept inside the known shadows: nothing to trace
                     cover.setdefault(e[1], []).append((a, b))
                 for e in self._not_point(inside, t, q0, dq):
                     traced.setdefault(e[1], []).append((a, b))
-                quads, ends = self._trace_many(edges, t, toward, q0, dq)
                 stats["edges"] += len(edges)
                 pieces.extend(quads)
                 for e, end in zip(edges, ends, strict=True):
@@ -926,6 +923,34 @@ class Sweeper:
                 stats["refined"] += 1
                 pieces.append(frame(gap)[0])
                 todo += [(a, gap, depth + 1), (gap, b, depth + 1)]
+
+    def _interval_traces(
+        self, intervals: list[tuple[float, float]], q0: np.ndarray, q1: np.ndarray, frame
+    ) -> dict[tuple[float, float], list]:
+        """Per interval ``(a, b)`` of sample times of the sweep ``q0 -> q1``: for the
+        shadow edges at ``a`` traced towards ``b``, then those at ``b`` towards ``a``,
+        ``(edges, quads, ends)``: the edges whose sweep leaves the two samples' shadows
+        (:meth:`_uncovered_seen`, else :meth:`_uncovered`) and what :meth:`_trace_many`
+        makes of them, all intervals' traces in one batch (:meth:`_trace_groups`)."""
+        dq = q1 - q0
+        groups = []
+        for a, b in intervals:
+            # the areal part: GEOS's union of two nearly coincident shadows can carry
+            # collapsed edges (LineStrings), and an overlay with such a collection fails
+            # ("Result area inconsistent with overlay operation", fuzz seed 501057)
+            known = None  # the shadows' union, only if their X (see _uncovered_seen) is not kept
+            for t, toward in ((a, b), (b, a)):
+                edges = self._uncovered_seen(frame(t)[1], t, toward, (a, b), q0, q1)
+                if edges is None:
+                    if known is None:
+                        known = areal(shapely.union(frame(a)[0], frame(b)[0]))
+                    edges = self._uncovered(frame(t)[1], t, toward, known, q0, dq)
+                groups.append((edges, t, toward))
+        got = self._trace_groups(groups, q0, dq)
+        return {
+            ab: [(groups[2 * k + j][0], *got[2 * k + j]) for j in (0, 1)]
+            for k, ab in enumerate(intervals)
+        }
 
     def _events(self, q0: np.ndarray, dq: np.ndarray) -> tuple[np.ndarray, list]:
         """Times in (0, 1), sorted, at which the target moving along ``q0 + t dq`` meets
@@ -1521,49 +1546,77 @@ class Sweeper:
     def _trace_many(self, edges: list, ta: float, tb: float, q0, dq) -> tuple[list, list]:
         """Areas swept by moving shadow edges found at sample ``ta`` while they live
         between ``ta`` and ``tb``; returns ``(quads, end time reached per edge)``."""
-        if not edges:
-            return [], []
-        ts, vs, ve = self._grid(edges, ta, tb, q0, dq)
-        ok = self._valid_many(vs, ve, np.broadcast_to(ts, vs.shape[:2]), q0, dq)
-        n_ok = np.where(ok.all(axis=1), len(ts), np.argmin(ok, axis=1))
-        # bisect the death time of the edges that die inside the interval
-        dying = np.flatnonzero((n_ok > 0) & (n_ok < len(ts)))
-        t_end = np.full(len(edges), float(ts[-1]))
+        return self._trace_groups([(edges, ta, tb)], q0, dq)[0]
+
+    def _trace_groups(self, groups: list[tuple], q0, dq) -> list[tuple[list, list]]:
+        """:meth:`_trace_many` for each group ``(edges, ta, tb)`` of the sweep ``q0 + t dq``,
+        in one batch: the time grids are each group's own (:meth:`_grid`), padded with their
+        last column to a common length (the exact point test tests equal rows once, and
+        every step decides row by row), so each group gets what it would alone."""
+        out: list[tuple[list, list]] = [([], []) for _ in groups]
+        live = [g for g, (edges, _, _) in enumerate(groups) if edges]
+        if not live:
+            return out
+        grids = [self._grid(groups[g][0], groups[g][1], groups[g][2], q0, dq) for g in live]
+        width = max(len(ts) for ts, _, _ in grids)
+
+        def pad(x: np.ndarray) -> np.ndarray:
+            return np.concatenate([x, np.repeat(x[:, -1:], width - x.shape[1], axis=1)], axis=1)
+
+        rows = [len(groups[g][0]) for g in live]
+        ts = np.concatenate(
+            [np.repeat(pad(g[0][None, :]), n, axis=0) for g, n in zip(grids, rows, strict=True)]
+        )
+        vs = np.concatenate([pad(v) for _, v, _ in grids])
+        ve = np.concatenate([pad(v) for _, _, v in grids])
+        n_t = np.repeat([len(t) for t, _, _ in grids], rows)  # each row's own grid length
+        ok = self._valid_many(vs, ve, ts, q0, dq) | (np.arange(width)[None, :] >= n_t[:, None])
+        n_ok = np.where(ok.all(axis=1), n_t, np.argmin(ok, axis=1))
+        edges = [e for g in live for e in groups[g][0]]
+        # bisect the death time of the edges that die inside their interval
+        dying = np.flatnonzero((n_ok > 0) & (n_ok < n_t))
+        t_end = ts[np.arange(len(edges)), n_t - 1].astype(float)
         if len(dying):
-            t_ok = ts[n_ok[dying] - 1].astype(float)
-            t_bad = ts[n_ok[dying]].astype(float)
+            t_ok = ts[dying, n_ok[dying] - 1].astype(float)
+            t_bad = ts[dying, n_ok[dying]].astype(float)
             sub = [edges[i] for i in dying]
             t_ok, t_bad = self._bisect(sub, t_ok, t_bad, q0, dq)
             t_end[dying] = t_ok
-        # the ends on the grid are vs, ve; those at the death times in one batch
-        if len(dying):
+            # the ends at the death times in one batch (those on the grid are vs, ve)
             da, db = self._ends_many(sub, t_end[dying][:, None], q0, dq)
             if self.lazy_samples:  # the death's band: see _past_death
                 ba, bb = self._ends_many(sub, t_bad[:, None], q0, dq)
                 late = self._past_death(da, db, ba, bb)
                 t_end[dying[late]] = t_bad[late]
                 da[late], db[late] = ba[late], bb[late]
-        quads, ends = [], []
-        for i in range(len(edges)):
-            k = int(n_ok[i])
-            if k == 0:
-                ends.append(ta)
-                continue
-            a, b = vs[i, :k], ve[i, :k]
-            if k < len(ts):
-                j = int(np.searchsorted(dying, i))
-                a, b = np.vstack([a, da[j]]), np.vstack([b, db[j]])
-            ends.append(float(ts[k - 1]) if k == len(ts) else float(t_end[i]))
-            if len(a) < 2:
-                continue
-            quads.append(np.stack([a[:-1], a[1:], b[1:], b[:-1]], axis=1))
-        if not quads:
-            return [], ends
-        polys = shapely.polygons(np.concatenate(quads))
+        quads: list[list] = [[] for _ in live]
+        first = np.cumsum([0] + rows)
+        for k, g in enumerate(live):
+            ta, ends = groups[g][1], out[g][1]
+            for i in range(first[k], first[k + 1]):
+                n = int(n_ok[i])
+                if n == 0:
+                    ends.append(ta)
+                    continue
+                a, b = vs[i, :n], ve[i, :n]
+                if n < n_t[i]:
+                    j = int(np.searchsorted(dying, i))
+                    a, b = np.vstack([a, da[j]]), np.vstack([b, db[j]])
+                ends.append(float(ts[i, n - 1]) if n == n_t[i] else float(t_end[i]))
+                if len(a) < 2:
+                    continue
+                quads[k].append(np.stack([a[:-1], a[1:], b[1:], b[:-1]], axis=1))
+        counts = [sum(len(x) for x in qs) for qs in quads]
+        if not sum(counts):
+            return out
+        polys = shapely.polygons(np.concatenate([x for qs in quads for x in qs]))
         bad = ~shapely.is_valid(polys)
         if bad.any():
             polys[bad] = shapely.make_valid(polys[bad])
-        return list(polys), ends
+        at = np.cumsum([0] + counts)
+        for k, g in enumerate(live):
+            out[g] = (list(polys[at[k] : at[k + 1]]), out[g][1])
+        return out
 
     def _past_death(
         self, da: np.ndarray, db: np.ndarray, ba: np.ndarray, bb: np.ndarray
