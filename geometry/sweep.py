@@ -798,26 +798,32 @@ class Sweeper:
                 for r, mids in asked:
                     for t in mids:
                         r.frame(t)
+        with clock("tracing"):
+            # the first round of every segment's traces in one batch
+            jobs = [(r.q0, r.q1, r.frame, _pairs(sorted(r.frames))) for r in moving]
+            first = dict(zip(map(id, moving), self._interval_traces(jobs), strict=True))
         out = []
         for i, r in enumerate(runs):
             with clock("tracing"):
-                out.append(self._trace_run(r) if r in moving else [r.frame(0.0)[0]])
+                out.append(self._trace_run(r, first[id(r)]) if r in moving else [r.frame(0.0)[0]])
             if traced is not None:
                 traced(i)
         stats = {k: sum(r.stats[k] for r in runs) for k in ("samples", "edges", "refined")}
         return out, stats
 
-    def _trace_run(self, run: _Run) -> list[shapely.Geometry]:
+    def _trace_run(self, run: _Run, pre: dict | None = None) -> list[shapely.Geometry]:
         """The pieces of one segment once its samples are taken: its sampled shadows, then
-        the traces between them (:meth:`_sweep_intervals`), asking :meth:`_live_mids`
-        again after the tracing's refinements."""
+        the traces between them (:meth:`_sweep_intervals`; ``pre``: the traces of the
+        intervals between its samples, :meth:`_interval_traces`, if done ahead), asking
+        :meth:`_live_mids` again after the tracing's refinements."""
         q0, q1, dq, frame, stats = run.q0, run.q1, run.dq, run.frame, run.stats
         ts = sorted(run.frames)
         pieces = [frame(t)[0] for t in ts]
         state = _Cover()
-        todo = [(a, b, 0) for a, b in zip(ts[:-1], ts[1:], strict=True)]
+        todo = [(a, b, 0) for a, b in _pairs(ts)]
         while True:
-            self._sweep_intervals(todo, q0, q1, frame, pieces, state, stats)
+            self._sweep_intervals(todo, q0, q1, frame, pieces, state, stats, pre)
+            pre = None
             mids = self._live_mids(run.ev_t, run.ev_ids, run.frames, run.looked)
             if not mids:
                 return pieces
@@ -879,23 +885,31 @@ class Sweeper:
         return sorted(out)
 
     def _sweep_intervals(
-        self, todo: list, q0: np.ndarray, q1: np.ndarray, frame, pieces: list, state, stats
+        self,
+        todo: list,
+        q0: np.ndarray,
+        q1: np.ndarray,
+        frame,
+        pieces: list,
+        state,
+        stats,
+        pre: dict | None = None,
     ) -> None:
         """Trace the moving shadow edges over the intervals ``todo`` ((a, b, depth) each,
         sample times of the sweep ``q0 -> q1``), refining where a configuration may be
         born and gone in between; the traced quads and the refinement samples' shadows
         go to ``pieces``.  ``state`` (:class:`_Cover`) carries what the traces covered
-        from one call to the next."""
+        from one call to the next; ``pre``: traces of intervals done ahead (taken from it)."""
         dq = q1 - q0
         cover, confirmed, traced, probed = state.cover, state.confirmed, state.traced, state.probed
-        pre: dict[tuple[float, float], list] = {}  # interval -> its traces, both ways
+        pre = {} if pre is None else pre  # interval -> its traces, both ways
         while todo:
             self._check_time()
             if (todo[-1][0], todo[-1][1]) not in pre:
                 # the traces of every interval waiting, in one batch (a trace depends only
                 # on its interval's two samples, not on what the others covered)
                 wait = [(a_, b_) for a_, b_, _ in todo if (a_, b_) not in pre]
-                pre.update(self._interval_traces(wait, q0, q1, frame))
+                pre.update(self._interval_traces([(q0, q1, frame, wait)])[0])
             a, b, depth = todo.pop()
             cut: list[tuple] = []  # (edge, t_end, toward): traces ended by a neighbour's change
             done = pre.pop((a, b))
@@ -924,33 +938,36 @@ class Sweeper:
                 pieces.append(frame(gap)[0])
                 todo += [(a, gap, depth + 1), (gap, b, depth + 1)]
 
-    def _interval_traces(
-        self, intervals: list[tuple[float, float]], q0: np.ndarray, q1: np.ndarray, frame
-    ) -> dict[tuple[float, float], list]:
-        """Per interval ``(a, b)`` of sample times of the sweep ``q0 -> q1``: for the
-        shadow edges at ``a`` traced towards ``b``, then those at ``b`` towards ``a``,
-        ``(edges, quads, ends)``: the edges whose sweep leaves the two samples' shadows
-        (:meth:`_uncovered_seen`, else :meth:`_uncovered`) and what :meth:`_trace_many`
-        makes of them, all intervals' traces in one batch (:meth:`_trace_groups`)."""
-        dq = q1 - q0
+    def _interval_traces(self, jobs: list[tuple]) -> list[dict[tuple[float, float], list]]:
+        """Per job ``(q0, q1, frame, intervals)`` (a sweep ``q0 -> q1``, its frames, intervals
+        ``(a, b)`` of its sample times), per interval: for the shadow edges at ``a`` traced
+        towards ``b``, then those at ``b`` towards ``a``, ``(edges, quads, ends)``: the edges
+        whose sweep leaves the two samples' shadows (:meth:`_uncovered_seen`, else
+        :meth:`_uncovered`) and what :meth:`_trace_many` makes of them; all the traces in one
+        batch (:meth:`_trace_groups`)."""
         groups = []
-        for a, b in intervals:
-            # the areal part: GEOS's union of two nearly coincident shadows can carry
-            # collapsed edges (LineStrings), and an overlay with such a collection fails
-            # ("Result area inconsistent with overlay operation", fuzz seed 501057)
-            known = None  # the shadows' union, only if their X (see _uncovered_seen) is not kept
-            for t, toward in ((a, b), (b, a)):
-                edges = self._uncovered_seen(frame(t)[1], t, toward, (a, b), q0, q1)
-                if edges is None:
-                    if known is None:
-                        known = areal(shapely.union(frame(a)[0], frame(b)[0]))
-                    edges = self._uncovered(frame(t)[1], t, toward, known, q0, dq)
-                groups.append((edges, t, toward))
-        got = self._trace_groups(groups, q0, dq)
-        return {
-            ab: [(groups[2 * k + j][0], *got[2 * k + j]) for j in (0, 1)]
-            for k, ab in enumerate(intervals)
-        }
+        for q0, q1, frame, intervals in jobs:
+            dq = q1 - q0
+            for a, b in intervals:
+                # the areal part: GEOS's union of two nearly coincident shadows can carry
+                # collapsed edges (LineStrings), and an overlay with such a collection fails
+                # ("Result area inconsistent with overlay operation", fuzz seed 501057)
+                known = None  # the shadows' union, if their X (see _uncovered_seen) is not kept
+                for t, toward in ((a, b), (b, a)):
+                    edges = self._uncovered_seen(frame(t)[1], t, toward, (a, b), q0, q1)
+                    if edges is None:
+                        if known is None:
+                            known = areal(shapely.union(frame(a)[0], frame(b)[0]))
+                        edges = self._uncovered(frame(t)[1], t, toward, known, q0, dq)
+                    groups.append((edges, t, toward, q0, dq))
+        got = iter(zip(groups, self._trace_groups(groups), strict=True))
+        out = []
+        for _, _, _, intervals in jobs:
+            done = {}
+            for ab in intervals:
+                done[ab] = [(g[0], *tr) for g, tr in (next(got), next(got))]
+            out.append(done)
+        return out
 
     def _events(self, q0: np.ndarray, dq: np.ndarray) -> tuple[np.ndarray, list]:
         """Times in (0, 1), sorted, at which the target moving along ``q0 + t dq`` meets
@@ -1546,18 +1563,19 @@ class Sweeper:
     def _trace_many(self, edges: list, ta: float, tb: float, q0, dq) -> tuple[list, list]:
         """Areas swept by moving shadow edges found at sample ``ta`` while they live
         between ``ta`` and ``tb``; returns ``(quads, end time reached per edge)``."""
-        return self._trace_groups([(edges, ta, tb)], q0, dq)[0]
+        return self._trace_groups([(edges, ta, tb, q0, dq)])[0]
 
-    def _trace_groups(self, groups: list[tuple], q0, dq) -> list[tuple[list, list]]:
-        """:meth:`_trace_many` for each group ``(edges, ta, tb)`` of the sweep ``q0 + t dq``,
-        in one batch: the time grids are each group's own (:meth:`_grid`), padded with their
-        last column to a common length (the exact point test tests equal rows once, and
-        every step decides row by row), so each group gets what it would alone."""
+    def _trace_groups(self, groups: list[tuple]) -> list[tuple[list, list]]:
+        """:meth:`_trace_many` for each group ``(edges, ta, tb, q0, dq)`` (edges of the sweep
+        ``q0 + t dq``), in one batch: the time grids are each group's own (:meth:`_grid`),
+        padded with their last column to a common length, and every row carries its sweep
+        (the exact point test tests equal rows once, and every step decides row by row), so
+        each group gets what it would alone."""
         out: list[tuple[list, list]] = [([], []) for _ in groups]
-        live = [g for g, (edges, _, _) in enumerate(groups) if edges]
+        live = [g for g, grp in enumerate(groups) if grp[0]]
         if not live:
             return out
-        grids = [self._grid(groups[g][0], groups[g][1], groups[g][2], q0, dq) for g in live]
+        grids = [self._grid(*groups[g]) for g in live]
         width = max(len(ts) for ts, _, _ in grids)
 
         def pad(x: np.ndarray) -> np.ndarray:
@@ -1570,6 +1588,12 @@ class Sweeper:
         vs = np.concatenate([pad(v) for _, v, _ in grids])
         ve = np.concatenate([pad(v) for _, _, v in grids])
         n_t = np.repeat([len(t) for t, _, _ in grids], rows)  # each row's own grid length
+        q0 = np.concatenate(
+            [np.repeat(groups[g][3][None, None, :], n, 0) for g, n in zip(live, rows, strict=True)]
+        )
+        dq = np.concatenate(
+            [np.repeat(groups[g][4][None, None, :], n, 0) for g, n in zip(live, rows, strict=True)]
+        )
         ok = self._valid_many(vs, ve, ts, q0, dq) | (np.arange(width)[None, :] >= n_t[:, None])
         n_ok = np.where(ok.all(axis=1), n_t, np.argmin(ok, axis=1))
         edges = [e for g in live for e in groups[g][0]]
@@ -1580,12 +1604,13 @@ class Sweeper:
             t_ok = ts[dying, n_ok[dying] - 1].astype(float)
             t_bad = ts[dying, n_ok[dying]].astype(float)
             sub = [edges[i] for i in dying]
-            t_ok, t_bad = self._bisect(sub, t_ok, t_bad, q0, dq)
+            q0d, dqd = q0[dying], dq[dying]
+            t_ok, t_bad = self._bisect(sub, t_ok, t_bad, q0d, dqd)
             t_end[dying] = t_ok
             # the ends at the death times in one batch (those on the grid are vs, ve)
-            da, db = self._ends_many(sub, t_end[dying][:, None], q0, dq)
+            da, db = self._ends_many(sub, t_end[dying][:, None], q0d, dqd)
             if self.lazy_samples:  # the death's band: see _past_death
-                ba, bb = self._ends_many(sub, t_bad[:, None], q0, dq)
+                ba, bb = self._ends_many(sub, t_bad[:, None], q0d, dqd)
                 late = self._past_death(da, db, ba, bb)
                 t_end[dying[late]] = t_bad[late]
                 da[late], db[late] = ba[late], bb[late]
@@ -1662,7 +1687,10 @@ class Sweeper:
             if self.lazy_samples:
                 sub = [edges[i] for i in active]
                 ta, tb = self._ends_many(
-                    sub, np.stack([t_ok[active], t_bad[active]], axis=1), q0, dq
+                    sub,
+                    np.stack([t_ok[active], t_bad[active]], axis=1),
+                    _rows(q0, active),
+                    _rows(dq, active),
                 )
                 active = active[~self._past_death(ta[:, :1], tb[:, :1], ta[:, 1:], tb[:, 1:])]
             if not len(active):
@@ -1679,8 +1707,9 @@ class Sweeper:
                 lo = np.stack([lo, mid], axis=-1).reshape(len(active), -1)
                 hi = np.stack([mid, hi], axis=-1).reshape(len(active), -1)
             tm = np.concatenate(mids, axis=1)  # (E, 2**levels - 1), level by level
-            a, b = self._ends_many(sub, tm, q0, dq)
-            good = self._valid_many(a, b, tm, q0, dq)
+            q0a, dqa = _rows(q0, active), _rows(dq, active)
+            a, b = self._ends_many(sub, tm, q0a, dqa)
+            good = self._valid_many(a, b, tm, q0a, dqa)
             node = np.zeros(len(active), dtype=np.int64)
             first = 0
             for level in range(levels):
@@ -1861,7 +1890,9 @@ class Sweeper:
         ok = self._probes_blind(np.concatenate([ends, inner], axis=-2), q) & (ln > 0)
         if ok.any():
             vs2, d2, q2 = vs[ok][:, None], d[ok][:, None], q[ok][:, None]
-            fb = self._between_lines(vs2, d2, np.asarray(ts)[ok][:, None], q0, dq)
+            q0k = np.broadcast_to(q0, q.shape)[ok][:, None]  # each row's sweep
+            dqk = np.broadcast_to(dq, q.shape)[ok][:, None]
+            fb = self._between_lines(vs2, d2, np.asarray(ts)[ok][:, None], q0k, dqk)
             eh = edge_h[ok][:, None]
             fb = np.clip(np.where(np.isfinite(fb), fb, 0.5), eh, 1 - eh)
             more = vs2[..., None, :] + fb[..., None] * d2[..., None, :] + nrm[ok][:, None, None, :]
@@ -1877,6 +1908,17 @@ class Sweeper:
         res = np.zeros(len(flat_p), dtype=bool)
         res[finite] = self.blind(flat_p[finite], flat_q[finite])
         return res.reshape(probes.shape[:-1]).all(axis=-1)
+
+
+def _pairs(ts: list[float]) -> list[tuple[float, float]]:
+    """Consecutive pairs ``(ts[i], ts[i + 1])`` of a sorted list of times."""
+    return list(zip(ts[:-1], ts[1:], strict=True))
+
+
+def _rows(x: np.ndarray, idx: np.ndarray) -> np.ndarray:
+    """Rows ``idx`` of a per-row array ``x`` (E, 1, 2), or ``x`` itself when it is one row
+    for all (2,)."""
+    return x if x.ndim == 1 else x[idx]
 
 
 def _tangent(w: np.ndarray, bp: np.ndarray, bn: np.ndarray, rel: float = 1e-9) -> np.ndarray:
