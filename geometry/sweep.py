@@ -269,6 +269,8 @@ class Sweeper:
         #: ``grazing`` mask they were computed with
         self._weak_pre: dict[tuple[float, float], tuple] = {}
         self._eroded_pre: dict[tuple, shapely.Geometry] = {}
+        #: :meth:`outline` per configuration (x, y), with strips
+        self._outlines: dict[tuple[float, float], tuple] = {}
         #: where the sweep's time went (:class:`PhaseClock`)
         self.clock = PhaseClock(lambda: len(self._frames))
 
@@ -298,6 +300,16 @@ class Sweeper:
         ring = self.ring0 + q
         if self.strips is None:
             return ring, np.ones(m, dtype=bool), n + np.arange(m)
+        key = (float(q[0]), float(q[1]))
+        got = self._outlines.get(key)
+        if got is None:  # once per configuration (the batch and the shadow both ask)
+            got = self._outlines[key] = self._cut_outline(ring)
+        return got
+
+    def _cut_outline(self, ring: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`outline` of the target ``ring`` (counter-clockwise, placed) cut by the
+        strips."""
+        n, m = self.n_fixed, self.m
         pts, wanted, ids = [], [], []
         for i in range(m):
             a, e = ring[i], self.edge0[i]
