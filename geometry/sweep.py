@@ -957,6 +957,13 @@ class Sweeper:
         whose sweep leaves the two samples' shadows (:meth:`_uncovered_seen`, else
         :meth:`_uncovered`) and what :meth:`_trace_many` makes of them; all the traces in one
         batch (:meth:`_trace_groups`)."""
+        items = [
+            (frame(t)[1], t, toward, (a, b), q0, q1)
+            for q0, q1, frame, intervals in jobs
+            for a, b in intervals
+            for t, toward in ((a, b), (b, a))
+        ]
+        seen = iter(self._uncovered_seen_many(items))
         groups = []
         for q0, q1, frame, intervals in jobs:
             dq = q1 - q0
@@ -966,7 +973,7 @@ class Sweeper:
                 # ("Result area inconsistent with overlay operation", fuzz seed 501057)
                 known = None  # the shadows' union, if their X (see _uncovered_seen) is not kept
                 for t, toward in ((a, b), (b, a)):
-                    edges = self._uncovered_seen(frame(t)[1], t, toward, (a, b), q0, q1)
+                    edges = next(seen)
                     if edges is None:
                         if known is None:
                             known = areal(shapely.union(frame(a)[0], frame(b)[0]))
@@ -1209,11 +1216,23 @@ class Sweeper:
         known shadows and not traced, and the fan was missed (fuzz seed 203869: 3.5e-8 D²
         of shadow at a configuration between samples, kept in the ``conservative=True``
         region)."""
-        _, vs, ve = self._grid(edges, min(t, toward), max(t, toward), q0, dq)  # (E, T, 2) each
-        ring = np.concatenate([vs, ve[:, ::-1]], axis=1)
-        ok = np.isfinite(ring).all(axis=(1, 2))
-        polys = shapely.make_valid(shapely.polygons(np.where(ok[:, None, None], ring, 0.0)))
-        return polys, ok
+        return self._strips_many([(edges, t, toward, q0, dq)])[0]
+
+    def _strips_many(self, groups: list[tuple]) -> list[tuple[np.ndarray, np.ndarray]]:
+        """:meth:`_strips` for each group ``(edges, t, toward, q0, dq)`` (edges not empty),
+        the grids in one batch (:meth:`_grid_many`)."""
+        grids = self._grid_many(
+            [(e, min(t, toward), max(t, toward), q0, dq) for e, t, toward, q0, dq in groups]
+        )
+        rings, oks = [], []
+        for _, vs, ve in grids:  # (E, T, 2) each
+            ring = np.concatenate([vs, ve[:, ::-1]], axis=1)
+            ok = np.isfinite(ring).all(axis=(1, 2))
+            rings.append(shapely.polygons(np.where(ok[:, None, None], ring, 0.0)))
+            oks.append(ok)
+        polys = shapely.make_valid(np.concatenate(rings))
+        at = np.cumsum([0] + [len(r) for r in rings])
+        return [(polys[at[k] : at[k + 1]], ok) for k, ok in enumerate(oks)]
 
     def _uncovered(self, edges: list, t: float, toward: float, known, q0, dq) -> list:
         """The edges whose sweep from t to ``toward`` (assuming it lives that long)
@@ -1242,23 +1261,49 @@ class Sweeper:
         width times ``F``'s perimeter), which the threshold is lowered by, so no sweep
         that :meth:`_uncovered` would trace is dropped; ``quad n X_a n X_b`` is not cut by
         ``F`` (that area is only larger)."""
-        if not edges:
-            return []
-        ka, kb = (self._frame_key(q0, q1, u) for u in ab)
-        inter = self._seen_pair(ka, kb)
-        if inter is None:
-            return None
-        polys, ok = self._strips(edges, t, toward, q0, q1 - q0)
+        return self._uncovered_seen_many([(edges, t, toward, ab, q0, q1)])[0]
+
+    def _uncovered_seen_many(self, items: list[tuple]) -> list[list | None]:
+        """:meth:`_uncovered_seen` for each item ``(edges, t, toward, ab, q0, q1)``, the strips
+        and the overlays of all items in one batch (shapely's functions act element by
+        element, so each item gets what it would alone)."""
+        out: list[list | None] = [None] * len(items)
+        todo, inters = [], []
+        for k, (edges, _, _, ab, q0, q1) in enumerate(items):
+            if not edges:
+                out[k] = []
+                continue
+            inter = self._seen_pair(*(self._frame_key(q0, q1, u) for u in ab))
+            if inter is not None:
+                todo.append(k)
+                inters.append(inter)
+        if not todo:
+            return out
+        got = self._strips_many(
+            [
+                (items[k][0], items[k][1], items[k][2], items[k][4], items[k][5] - items[k][4])
+                for k in todo
+            ]
+        )
+        polys = np.concatenate([p for p, _ in got])
+        ok = np.concatenate([o for _, o in got])
+        counts = [len(o) for _, o in got]
+        inter = np.repeat(np.asarray(inters, dtype=object), counts)
         grown, band = self._free_grown_eps()
         rest = np.zeros(len(polys))
         idx = np.flatnonzero(ok)
-        meets = shapely.intersects(inter, polys[idx])
-        rest[idx[meets]] = shapely.area(shapely.intersection(polys[idx[meets]], inter))
-        out = idx[~shapely.covers(grown, polys[idx])]
-        if len(out):
-            rest[out] += shapely.area(shapely.difference(polys[out], self.free))
+        meets = shapely.intersects(inter[idx], polys[idx])
+        sel = idx[meets]
+        rest[sel] = shapely.area(shapely.intersection(polys[sel], inter[sel]))
+        off = idx[~shapely.covers(grown, polys[idx])]
+        if len(off):
+            rest[off] += shapely.area(shapely.difference(polys[off], self.free))
         need = ~ok | (rest > 1e-9 * self.env.scale**2 - band)
-        return [e for e, n_ in zip(edges, need, strict=True) if n_]
+        at = np.cumsum([0] + counts)
+        for j, k in enumerate(todo):
+            flags = need[at[j] : at[j + 1]]
+            out[k] = [e for e, n_ in zip(items[k][0], flags, strict=True) if n_]
+        return out
 
     @staticmethod
     def _frame_key(q0: np.ndarray, q1: np.ndarray, t: float) -> tuple[float, float]:
@@ -1587,7 +1632,7 @@ class Sweeper:
         live = [g for g, grp in enumerate(groups) if grp[0]]
         if not live:
             return out
-        grids = [self._grid(*groups[g]) for g in live]
+        grids = self._grid_many([groups[g] for g in live])
         width = max(len(ts) for ts, _, _ in grids)
 
         def pad(x: np.ndarray) -> np.ndarray:
@@ -1756,25 +1801,54 @@ class Sweeper:
     def _grid(self, edges: list, a: float, b: float, q0, dq) -> tuple[np.ndarray, ...]:
         """Times from a to b so fine that the traced polylines stay within tol, and the
         ends of every edge at those times (:meth:`_ends_many`, (E, T, 2) each)."""
+        return self._grid_many([(edges, a, b, q0, dq)])[0]
+
+    def _grid_many(self, groups: list[tuple]) -> list[tuple[np.ndarray, ...]]:
+        """:meth:`_grid` for each group ``(edges, a, b, q0, dq)`` (edges of the sweep ``q0 + t
+        dq``, not empty): the groups still refining take each step together (one
+        :meth:`_ends_many` call, each row with its own times and sweep), so each gets what
+        it would alone."""
+        out: list[tuple[np.ndarray, ...]] = [() for _ in groups]
+        todo = list(range(len(groups)))
         n = 9
-        while True:
-            ts = np.linspace(a, b, n)
-            mid = 0.5 * (ts[:-1] + ts[1:])
-            err = 0.0
+        while todo:
+            rows = [len(groups[g][0]) for g in todo]
+            tss = [np.linspace(groups[g][1], groups[g][2], n) for g in todo]
             # the ends at the grid times and at the midpoints in one call (row by row)
-            both = self._ends_many(edges, np.concatenate([ts, mid])[None, :], q0, dq)
+            times = np.concatenate(
+                [
+                    np.repeat(np.concatenate([ts, 0.5 * (ts[:-1] + ts[1:])])[None, :], r, axis=0)
+                    for ts, r in zip(tss, rows, strict=True)
+                ]
+            )
+            q0, dq = (
+                np.concatenate(
+                    [
+                        np.repeat(groups[g][c][None, None, :], r, axis=0)
+                        for g, r in zip(todo, rows, strict=True)
+                    ]
+                )
+                for c in (3, 4)
+            )
+            both = self._ends_many([e for g in todo for e in groups[g][0]], times, q0, dq)
             ends = [c[:, :n] for c in both]
-            mids = [c[:, n:] for c in both]
-            for c, m in zip(ends, mids, strict=True):
+            err = np.zeros(len(times))  # per row: the largest finite deviation of a chord
+            for c, m in zip(ends, (c[:, n:] for c in both), strict=True):
                 chord = c[:, 1:] - c[:, :-1]
                 ln = np.hypot(chord[..., 0], chord[..., 1])
                 with np.errstate(divide="ignore", invalid="ignore"):
                     dev = np.where(ln > 0, np.abs(_cross(chord, m - c[:, :-1])) / ln, 0.0)
-                dev = dev[np.isfinite(dev)]
-                err = max(err, float(dev.max()) if len(dev) else 0.0)
-            if err <= self.tol or n >= 257:
-                return ts, ends[0], ends[1]
+                err = np.maximum(err, np.where(np.isfinite(dev), dev, 0.0).max(axis=1))
+            at = np.cumsum([0] + rows)
+            left = []
+            for k, g in enumerate(todo):
+                if float(err[at[k] : at[k + 1]].max()) <= self.tol or n >= 257:
+                    out[g] = (tss[k], ends[0][at[k] : at[k + 1]], ends[1][at[k] : at[k + 1]])
+                else:
+                    left.append(g)
+            todo = left
             n = 2 * n - 1
+        return out
 
     def _between_lines(self, vs: np.ndarray, d: np.ndarray, ts: np.ndarray, q0, dq) -> np.ndarray:
         """Fractions along each edge (E, T, K) between consecutive crossings of the

@@ -3,12 +3,17 @@ definitions (issue 25 item 1: speed without changing answers)."""
 
 from __future__ import annotations
 
+import json
+from pathlib import Path
+
 import numpy as np
 import pytest
 import shapely
 
 from geometry import Scene, partial_region, recognizable_region
 from geometry import sweep as S
+
+REPRO = Path(__file__).parent / "fuzz_repro"
 
 
 def _drop_short_loop(v: np.ndarray, length: float) -> np.ndarray:
@@ -257,19 +262,22 @@ def test_uncovered_from_what_the_samples_do_not_hold_equals_uncovered_by_their_u
     """The edges whose sweep leaves the two samples' shadows, found from X_a n X_b, are
     those found from the union of the two shadows (the definition)."""
     calls = {"n": 0, "traced": 0}
-    orig = S.Sweeper._uncovered_seen
+    orig = S.Sweeper._uncovered_seen_many
 
-    def both(self, edges, t, toward, ab, q0, q1):
-        got = orig(self, edges, t, toward, ab, q0, q1)
-        if edges:
-            ka, kb = (self._frame_key(q0, q1, u) for u in ab)
-            known = S.areal(shapely.union(self._frames[ka][0], self._frames[kb][0]))
-            assert got == self._uncovered(edges, t, toward, known, q0, q1 - q0)
-            calls["n"] += 1
-            calls["traced"] += len(got)
-        return got
+    def both(self, items):
+        out = orig(self, items)
+        for (edges, t, toward, ab, q0, q1), got in zip(items, out, strict=True):
+            if edges:
+                ka, kb = (self._frame_key(q0, q1, u) for u in ab)
+                known = S.areal(shapely.union(self._frames[ka][0], self._frames[kb][0]))
+                assert got == self._uncovered(edges, t, toward, known, q0, q1 - q0)
+                # the batch gives each item what it gives alone
+                assert got == orig(self, [(edges, t, toward, ab, q0, q1)])[0]
+                calls["n"] += 1
+                calls["traced"] += len(got)
+        return out
 
-    monkeypatch.setattr(S.Sweeper, "_uncovered_seen", both)
+    monkeypatch.setattr(S.Sweeper, "_uncovered_seen_many", both)
     for scene in ("lab", "edr"):
         partial_region(
             Scene.load(f"sensorplan_gym/scenes/{scene}.json"), target_in="goal", theta=0.0
@@ -444,3 +452,58 @@ def test_corners_that_see_k_are_those_inside_its_weak_visibility_region(name, mo
     )
     left = shapely.points(sw.env.vert[old & ~new])
     assert (shapely.distance(seen.boundary, left) <= 1e-6 * sw.env.scale).all()
+
+
+def _batches(monkeypatch, name: str, scene: Scene, rec: bool) -> list:
+    """Every call of the batched ``name`` method (its sweeper, arguments, answer) during the
+    swept partial query over G (``rec``: the 5.2 query) on ``scene``."""
+    calls = []
+    orig = getattr(S.Sweeper, name)
+
+    def spy(self, groups):
+        out = orig(self, groups)
+        calls.append((self, groups, out))
+        return out
+
+    monkeypatch.setattr(S.Sweeper, name, spy)
+    if rec:
+        recognizable_region(scene, model="partial", theta=0.0)
+    else:
+        partial_region(scene, target_in="goal", theta=0.0)
+    monkeypatch.setattr(S.Sweeper, name, orig)
+    return calls
+
+
+def _same_trace(a: tuple, b: tuple) -> bool:
+    """Two answers of _trace_many, bit for bit: the quads' WKB and the end times."""
+    return [shapely.to_wkb(q) for q in a[0]] == [shapely.to_wkb(q) for q in b[0]] and a[1] == b[1]
+
+
+@pytest.mark.parametrize(("scene", "rec"), [("slow_2", False), ("slow_1", False), ("lab", True)])
+def test_batched_traces_and_grids_equal_group_by_group(monkeypatch, scene, rec) -> None:
+    """_trace_groups and _grid_many give each group of a batch (intervals of several
+    segments of G, both directions) bit for bit what it gets alone: the rows of a batch
+    carry their own sweep and grid."""
+
+    def load() -> Scene:  # a fresh scene per query (a scene keeps its sweeps)
+        if scene == "lab":
+            return Scene.load("sensorplan_gym/scenes/lab.json")
+        return Scene.from_dict(json.loads((REPRO / f"{scene}.json").read_text())["scene"])
+
+    traces = _batches(monkeypatch, "_trace_groups", load(), rec)
+    grids = _batches(monkeypatch, "_grid_many", load(), rec)
+    # not vacuous: batches of several groups, with traced edges among them
+    multi = [c for c in traces if len([g for g in c[1] if g[0]]) > 1]
+    assert multi and any(sum(len(q) for q, _ in c[2]) for c in multi)
+    assert any(len(c[1]) > 1 for c in grids)
+    for sw, groups, out in multi:
+        for grp, got in zip(groups, out, strict=True):
+            assert _same_trace(got, sw._trace_groups([grp])[0])
+    for sw, groups, out in grids:
+        if len(groups) < 2:
+            continue
+        for grp, got in zip(groups, out, strict=True):
+            alone = sw._grid_many([grp])[0]
+            assert all(
+                np.array_equal(x, y, equal_nan=True) for x, y in zip(got, alone, strict=True)
+            )
