@@ -423,10 +423,11 @@ class Sweeper:
         key a pair of anchor ids spanning the line (shadow on the edge's left)."""
         out = []
         n = self.n_fixed
-        merged = [
-            _drop_short(np.asarray(ring.coords)[:-1, :2], self.tol_lab, self._vertex_at)
-            for ring in _rings(shapely.orient_polygons(shadow, exterior_cw=False))
-        ]
+        merged = _drop_short_many(
+            _ring_coords(_rings(shapely.orient_polygons(shadow, exterior_cw=False))),
+            self.tol_lab,
+            self._vertex_at,
+        )
         vs = [v for v in merged if len(v) >= 3]
         if not vs:
             return out
@@ -477,14 +478,7 @@ class Sweeper:
         anchors that are not both within ``tol_lab`` of any one anchor, so :meth:`_label`
         keys it by two fixed anchors (it prefers fixed ones): it does not move."""
         env = self.env.vert
-        keys = getattr(self, "_vert_keys", None)
-        if keys is None:
-            cell = np.round(env / self.shadow_grid)
-            keys = self._vert_keys = {
-                (float(x), float(y)): i for i, (x, y) in enumerate(cell.tolist())
-            }
-        cell = np.round(v / self.shadow_grid).tolist()
-        at = np.array([keys.get((x, y), -1) for x, y in cell], dtype=np.int64)
+        at = self._vertex_cell(v)
         ok = at >= 0
         ok[ok] = np.abs(env[at[ok]] - v[ok]).max(axis=1) <= 1e-12 * self.env.scale
         ring_of = np.repeat(np.arange(len(off) - 1), np.diff(off))
@@ -494,6 +488,26 @@ class Sweeper:
         out = np.zeros(len(v), dtype=bool)
         out[both] = np.abs(env[at[both]] - env[at[nxt[both]]]).max(axis=1) > 3.0 * self.tol_lab
         return out
+
+    def _vertex_cell(self, v: np.ndarray) -> np.ndarray:
+        """Per point of ``v`` (k, 2): the environment vertex in the same cell of the
+        ``shadow_grid`` (its coordinates rounded to the grid), the last one if several, or
+        -1.  The cells are sorted once (complex numbers order by x, then y)."""
+        got = getattr(self, "_vert_cells", None)
+        if got is None:
+            cell = np.round(self.env.vert / self.shadow_grid)
+            key = np.empty(len(cell), dtype=complex)
+            key.real, key.imag = cell[:, 0], cell[:, 1]
+            rev, first = np.unique(key[::-1], return_index=True)  # the last of equal cells
+            got = self._vert_cells = (rev, len(key) - 1 - first)
+        cells, idx = got
+        c = np.round(v / self.shadow_grid)
+        q = np.empty(len(c), dtype=complex)
+        q.real, q.imag = c[:, 0], c[:, 1]
+        pos = np.minimum(np.searchsorted(cells, q), max(len(cells) - 1, 0))
+        if not len(cells):
+            return np.full(len(v), -1, dtype=np.int64)
+        return np.where(cells[pos] == q, idx[pos], -1).astype(np.int64)
 
     def _label(
         self, v: np.ndarray, table: np.ndarray, tid: np.ndarray, d: np.ndarray | None = None
@@ -2068,6 +2082,39 @@ def _rings(g: shapely.Geometry) -> list:
         out.append(poly.exterior)
         out.extend(poly.interiors)
     return out
+
+
+def _ring_coords(rings: list) -> list[np.ndarray]:
+    """The vertices (n, 2) of each closed ring of ``rings`` (shapely LinearRings), without
+    the closing repeat, read in one call."""
+    if not rings:
+        return []
+    arr = np.asarray(rings, dtype=object)
+    xy = shapely.get_coordinates(arr)
+    at = np.cumsum(np.concatenate([[0], shapely.get_num_coordinates(arr)]))
+    return [xy[a : b - 1] for a, b in zip(at[:-1], at[1:], strict=True)]
+
+
+def _drop_short_many(
+    rings: list[np.ndarray],
+    length: float,
+    vertex_at: Callable[[np.ndarray], np.ndarray] | None = None,
+) -> list[np.ndarray]:
+    """:func:`_drop_short` of each closed ring of ``rings``: the rings without a step
+    shorter than ``length`` (the closing step included), most of them, are found in one
+    pass and come back as they are (as :func:`_drop_short` returns them)."""
+    flat = np.concatenate(rings) if rings else np.zeros((0, 2))
+    if len(flat) == 0:
+        return list(rings)
+    nxt = np.roll(flat, -1, axis=0)
+    off = np.cumsum([0] + [len(v) for v in rings])
+    last = off[1:] - 1  # each ring's closing step: from its last vertex to its first
+    nxt[last[off[1:] > off[:-1]]] = flat[off[:-1][off[1:] > off[:-1]]]
+    short = np.abs(nxt - flat).max(axis=1) < length
+    any_short = np.logical_or.reduceat(short, np.minimum(off[:-1], len(flat) - 1)) & (
+        off[1:] > off[:-1]
+    )
+    return [_drop_short(v, length, vertex_at) if any_short[k] else v for k, v in enumerate(rings)]
 
 
 def _drop_short(

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -38,6 +39,36 @@ def test_drop_short_matches_the_loop() -> None:
         assert got.shape == ref.shape
         assert np.abs(got - ref).max() <= 4e-6
         assert int((np.abs(got - ref) > 0).any(axis=1).sum()) <= k
+
+
+def test_drop_short_of_many_rings_is_ring_by_ring() -> None:
+    """_drop_short_many gives each ring what _drop_short gives it (the very array where
+    nothing is dropped), over batches mixing rings with and without short steps, short
+    closing steps, and rings of zero to two vertices; and _ring_coords reads shapely's
+    rings as their coordinates do."""
+    rng = np.random.default_rng(11)
+    slow = 0
+    for _ in range(300):
+        rings = []
+        for _ in range(rng.integers(1, 6)):
+            n = int(rng.choice([0, 1, 2, 5, 12]))
+            v = np.cumsum(rng.normal(size=(n, 2)), axis=0)
+            for i in rng.integers(0, max(n, 1), size=rng.integers(0, 3)) if n else []:
+                v[i] = v[i - 1] + 1e-9  # a short step (the closing one when i == 0)
+            rings.append(v)
+        got = S._drop_short_many(rings, 1e-6)
+        for v, g in zip(rings, got, strict=True):
+            ref = S._drop_short(v, 1e-6)
+            assert (g is v) == (ref is v)
+            assert np.array_equal(g, ref)
+            slow += g is not v
+    assert slow > 50  # not vacuous: many rings took the slow path
+    polys = shapely.buffer(shapely.points(rng.normal(size=(4, 2)) * 5), 1.0)
+    shapely.prepare(polys)
+    rings = S._rings(shapely.difference(shapely.box(-20, -20, 20, 20), shapely.union_all(polys)))
+    assert len(rings) > 1
+    for r, c in zip(rings, S._ring_coords(rings), strict=True):
+        assert np.array_equal(c, np.asarray(r.coords)[:-1, :2])
 
 
 def _sweeper(monkeypatch, scene: Scene | None = None) -> S.Sweeper:
@@ -507,3 +538,34 @@ def test_batched_traces_and_grids_equal_group_by_group(monkeypatch, scene, rec) 
             assert all(
                 np.array_equal(x, y, equal_nan=True) for x, y in zip(got, alone, strict=True)
             )
+
+
+def test_vertex_cells_by_sorting_equal_the_dictionary(monkeypatch) -> None:
+    """_vertex_cell (sorted complex keys) finds the vertex a dictionary of the rounded
+    coordinates finds (the last of equal cells), on the vertices themselves, on points
+    moved within and across a cell, on duplicated vertices and on points far away."""
+    sw = _sweeper(monkeypatch)
+    g = sw.shadow_grid
+    env = sw.env.vert
+    cells = np.round(env / g)
+    table = {(float(x), float(y)): i for i, (x, y) in enumerate(cells.tolist())}
+    rng = np.random.default_rng(5)
+    pts = np.vstack(
+        [
+            env,
+            env + rng.uniform(-0.4, 0.4, size=env.shape) * g,  # the same cell
+            env + rng.choice([-2.0, 2.0], size=env.shape) * g,  # a neighbouring cell
+            rng.uniform(-1e3, 1e3, size=(50, 2)),
+            -0.0 * env[:3],
+        ]
+    )
+    ref = [table.get((x, y), -1) for x, y in np.round(pts / g).tolist()]
+    got = sw._vertex_cell(pts)
+    assert got.tolist() == ref
+    assert (got[: len(env)] >= 0).all() and (got[2 * len(env) : 3 * len(env)] < 0).any()
+    # duplicated vertices: the last one, as the dictionary keeps it
+    dup = np.vstack([env, env[:5], env[2:4]])
+    fake = SimpleNamespace(env=SimpleNamespace(vert=dup), shadow_grid=g)
+    table = {(float(x), float(y)): i for i, (x, y) in enumerate(np.round(dup / g).tolist())}
+    ref = [table.get((x, y), -1) for x, y in np.round(pts / g).tolist()]
+    assert S.Sweeper._vertex_cell(fake, pts).tolist() == ref
