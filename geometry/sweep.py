@@ -939,11 +939,13 @@ class Sweeper:
             a, b, depth = todo.pop()
             cut: list[tuple] = []  # (edge, t_end, toward): traces ended by a neighbour's change
             done = pre.pop((a, b))
-            for (t, toward), (edges, quads, ends) in zip(((a, b), (b, a)), done, strict=True):
-                inside = [e for e in frame(t)[1] if e not in edges]
-                for e in inside:  # swept inside the known shadows: nothing to trace
-                    cover.setdefault(e[1], []).append((a, b))
-                for e in self._not_point(inside, t, q0, dq):
+            for (t, _), (edges, quads, ends, not_point, cut_short) in zip(
+                ((a, b), (b, a)), done, strict=True
+            ):
+                for e in frame(t)[1]:
+                    if e not in edges:  # swept inside the known shadows: nothing to trace
+                        cover.setdefault(e[1], []).append((a, b))
+                for e in not_point:
                     traced.setdefault(e[1], []).append((a, b))
                 stats["edges"] += len(edges)
                 pieces.extend(quads)
@@ -954,7 +956,7 @@ class Sweeper:
                         traced.setdefault(e[1], []).append((min(t, end), max(t, end)))
                     else:  # not confirmed even at its own sample: tracing cannot cover it
                         traced.setdefault(e[1], []).append((a, b))
-                cut += self._cut_short(edges, ends, t, toward, q0, dq)
+                cut += cut_short
                 confirmed.update((t, e[1]) for e in frame(t)[1] if e not in edges)
             gap = self._coverage_gap(frame(a)[1], frame(b)[1], cover, a, b, confirmed)
             if gap is None:
@@ -967,10 +969,12 @@ class Sweeper:
     def _interval_traces(self, jobs: list[tuple]) -> list[dict[tuple[float, float], list]]:
         """Per job ``(q0, q1, frame, intervals)`` (a sweep ``q0 -> q1``, its frames, intervals
         ``(a, b)`` of its sample times), per interval: for the shadow edges at ``a`` traced
-        towards ``b``, then those at ``b`` towards ``a``, ``(edges, quads, ends)``: the edges
-        whose sweep leaves the two samples' shadows (:meth:`_uncovered_seen`, else
-        :meth:`_uncovered`) and what :meth:`_trace_many` makes of them; all the traces in one
-        batch (:meth:`_trace_groups`)."""
+        towards ``b``, then those at ``b`` towards ``a``, ``(edges, quads, ends, not_point,
+        cut)``: the edges whose sweep leaves the two samples' shadows
+        (:meth:`_uncovered_seen`, else :meth:`_uncovered`), what :meth:`_trace_many` makes
+        of them, the other edges that are no point (:meth:`_not_point`) and the traces cut
+        short (:meth:`_cut_short`); each of these in one batch over all the intervals (none
+        depends on what the others covered)."""
         items = [
             (frame(t)[1], t, toward, (a, b), q0, q1)
             for q0, q1, frame, intervals in jobs
@@ -993,12 +997,22 @@ class Sweeper:
                             known = areal(shapely.union(frame(a)[0], frame(b)[0]))
                         edges = self._uncovered(frame(t)[1], t, toward, known, q0, dq)
                     groups.append((edges, t, toward, q0, dq))
-        got = iter(zip(groups, self._trace_groups(groups), strict=True))
+        traces = self._trace_groups(groups)
+        frames = [frame for _, _, frame, intervals in jobs for _ in intervals for _ in (0, 1)]
+        inside = [
+            ([e for e in frame(t)[1] if e not in edges], t, q0, dq)
+            for frame, (edges, t, _, q0, dq) in zip(frames, groups, strict=True)
+        ]
+        points = self._not_point_many(inside)
+        cuts = self._cut_short_many(
+            [(g[0], tr[1], *g[1:]) for g, tr in zip(groups, traces, strict=True)]
+        )
+        got = iter(zip(groups, traces, points, cuts, strict=True))
         out = []
         for _, _, _, intervals in jobs:
             done = {}
             for ab in intervals:
-                done[ab] = [(g[0], *tr) for g, tr in (next(got), next(got))]
+                done[ab] = [(g[0], *tr, pt, ct) for g, tr, pt, ct in (next(got), next(got))]
             out.append(done)
         return out
 
@@ -1358,29 +1372,62 @@ class Sweeper:
         (at least ``CUT_REL`` of its length at ``t``): not a shadow edge that shrank to a
         point, but one whose neighbouring edge died, so that its line goes on bounding the
         shadow with another neighbour (:meth:`_continuation_gap`)."""
-        span = abs(toward - t)
-        idx = [
-            i for i, end in enumerate(ends)
-            if end != t and abs(end - toward) > 1e-9 * span
-        ]  # fmt: skip
-        if not idx:
-            return []
-        sub = [edges[i] for i in idx]
-        te = np.array([[t, ends[i]] for i in idx])
+        return self._cut_short_many([(edges, ends, t, toward, q0, dq)])[0]
+
+    def _cut_short_many(self, items: list[tuple]) -> list[list]:
+        """:meth:`_cut_short` for each item ``(edges, ends, t, toward, q0, dq)``, the ends in
+        one batch."""
+        out: list[list] = [[] for _ in items]
+        picks = []  # (item, its indices)
+        for k, (_, ends, t, toward, _, _) in enumerate(items):
+            span = abs(toward - t)
+            idx = [
+                i for i, end in enumerate(ends)
+                if end != t and abs(end - toward) > 1e-9 * span
+            ]  # fmt: skip
+            if idx:
+                picks.append((k, idx))
+        if not picks:
+            return out
+        rows = [len(idx) for _, idx in picks]
+        sub = [items[k][0][i] for k, idx in picks for i in idx]
+        te = np.array([[items[k][2], items[k][1][i]] for k, idx in picks for i in idx])
+        q0, dq = _row_sweeps([items[k][4:6] for k, _ in picks], rows)
         vs, ve = self._ends_many(sub, te, q0, dq)
         ln = np.hypot(*np.moveaxis(ve - vs, -1, 0))  # (E, 2): at t and at the end
         long_ = np.isfinite(ln).all(axis=1) & (ln[:, 1] > CUT_REL * ln[:, 0])
-        return [(sub[k], ends[i], toward) for k, i in enumerate(idx) if long_[k]]
+        r = 0
+        for k, idx in picks:
+            edges, ends, _, toward = items[k][:4]
+            for i in idx:
+                if long_[r]:
+                    out[k].append((edges[i], ends[i], toward))
+                r += 1
+        return out
 
     def _not_point(self, edges: list, t: float, q0, dq) -> list:
         """The ``edges`` longer than ``1e-6`` of the scene's size at time ``t``: a shadow
         edge that is a point there (its neighbours' lines meet on its own) sweeps nothing
         in any configuration and tells nothing of the line's other configurations."""
-        if not edges:
-            return []
-        vs, ve = self._ends_many(edges, np.array([[t]]), q0, dq)
+        return self._not_point_many([(edges, t, q0, dq)])[0]
+
+    def _not_point_many(self, items: list[tuple]) -> list[list]:
+        """:meth:`_not_point` for each item ``(edges, t, q0, dq)``, the ends in one batch."""
+        out: list[list] = [[] for _ in items]
+        live = [k for k, it in enumerate(items) if it[0]]
+        if not live:
+            return out
+        rows = [len(items[k][0]) for k in live]
+        ts = np.concatenate([np.full((r, 1), items[k][1]) for k, r in zip(live, rows, strict=True)])
+        q0, dq = _row_sweeps([items[k][2:4] for k in live], rows)
+        vs, ve = self._ends_many([e for k in live for e in items[k][0]], ts, q0, dq)
         ln = np.hypot(*np.moveaxis(ve[:, 0] - vs[:, 0], -1, 0))
-        return [e for e, n_ in zip(edges, ln > 1e-6 * self.env.scale, strict=True) if n_]
+        long_ = ln > 1e-6 * self.env.scale
+        at = np.cumsum([0] + rows)
+        for j, k in enumerate(live):
+            flags = long_[at[j] : at[j + 1]]
+            out[k] = [e for e, n_ in zip(items[k][0], flags, strict=True) if n_]
+        return out
 
     def _continuation_gap(self, cut: list, traced: dict, probed: list, q0, dq) -> float | None:
         """A time just after a trace was cut short (:meth:`_cut_short`) at ``t_end``
@@ -1659,12 +1706,7 @@ class Sweeper:
         vs = np.concatenate([pad(v) for _, v, _ in grids])
         ve = np.concatenate([pad(v) for _, _, v in grids])
         n_t = np.repeat([len(t) for t, _, _ in grids], rows)  # each row's own grid length
-        q0 = np.concatenate(
-            [np.repeat(groups[g][3][None, None, :], n, 0) for g, n in zip(live, rows, strict=True)]
-        )
-        dq = np.concatenate(
-            [np.repeat(groups[g][4][None, None, :], n, 0) for g, n in zip(live, rows, strict=True)]
-        )
+        q0, dq = _row_sweeps([groups[g][3:5] for g in live], rows)
         ok = self._valid_many(vs, ve, ts, q0, dq) | (np.arange(width)[None, :] >= n_t[:, None])
         n_ok = np.where(ok.all(axis=1), n_t, np.argmin(ok, axis=1))
         edges = [e for g in live for e in groups[g][0]]
@@ -1835,15 +1877,7 @@ class Sweeper:
                     for ts, r in zip(tss, rows, strict=True)
                 ]
             )
-            q0, dq = (
-                np.concatenate(
-                    [
-                        np.repeat(groups[g][c][None, None, :], r, axis=0)
-                        for g, r in zip(todo, rows, strict=True)
-                    ]
-                )
-                for c in (3, 4)
-            )
+            q0, dq = _row_sweeps([groups[g][3:5] for g in todo], rows)
             both = self._ends_many([e for g in todo for e in groups[g][0]], times, q0, dq)
             ends = [c[:, :n] for c in both]
             err = np.zeros(len(times))  # per row: the largest finite deviation of a chord
@@ -2008,6 +2042,18 @@ class Sweeper:
         res = np.zeros(len(flat_p), dtype=bool)
         res[finite] = self.blind(flat_p[finite], flat_q[finite])
         return res.reshape(probes.shape[:-1]).all(axis=-1)
+
+
+def _row_sweeps(sweeps: list, rows: list[int]) -> tuple[np.ndarray, np.ndarray]:
+    """Per-row sweeps for a batch: ``(q0, dq)`` of each group of ``sweeps`` repeated over
+    its ``rows``, as (E, 1, 2) arrays (:meth:`Sweeper._ends_many` and the point tests take
+    them where they take one sweep's (2,) vectors)."""
+    return tuple(
+        np.concatenate(
+            [np.repeat(sw[c][None, None, :], r, axis=0) for sw, r in zip(sweeps, rows, strict=True)]
+        )
+        for c in (0, 1)
+    )  # type: ignore[return-value]
 
 
 def _pairs(ts: list[float]) -> list[tuple[float, float]]:
