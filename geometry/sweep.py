@@ -975,6 +975,7 @@ class Sweeper:
         of them, the other edges that are no point (:meth:`_not_point`) and the traces cut
         short (:meth:`_cut_short`); each of these in one batch over all the intervals (none
         depends on what the others covered)."""
+        self._check_time()
         items = [
             (frame(t)[1], t, toward, (a, b), q0, q1)
             for q0, q1, frame, intervals in jobs
