@@ -529,12 +529,12 @@ def test_batched_traces_and_grids_equal_group_by_group(monkeypatch, scene, rec) 
     assert any(len(c[1]) > 1 for c in grids)
     for sw, groups, out in multi:
         for grp, got in zip(groups, out, strict=True):
-            assert _same_trace(got, sw._trace_groups([grp])[0])
+            assert _same_trace(got, sw._trace_many(*grp))
     for sw, groups, out in grids:
         if len(groups) < 2:
             continue
         for grp, got in zip(groups, out, strict=True):
-            alone = sw._grid_many([grp])[0]
+            alone = sw._grid(*grp)
             assert all(
                 np.array_equal(x, y, equal_nan=True) for x, y in zip(got, alone, strict=True)
             )
