@@ -501,12 +501,12 @@ class Sweeper:
             rev, first = np.unique(key[::-1], return_index=True)  # the last of equal cells
             got = self._vert_cells = (rev, len(key) - 1 - first)
         cells, idx = got
+        if not len(cells):
+            return np.full(len(v), -1, dtype=np.int64)
         c = np.round(v / self.shadow_grid)
         q = np.empty(len(c), dtype=complex)
         q.real, q.imag = c[:, 0], c[:, 1]
-        pos = np.minimum(np.searchsorted(cells, q), max(len(cells) - 1, 0))
-        if not len(cells):
-            return np.full(len(v), -1, dtype=np.int64)
+        pos = np.minimum(np.searchsorted(cells, q), len(cells) - 1)
         return np.where(cells[pos] == q, idx[pos], -1).astype(np.int64)
 
     def _label(
