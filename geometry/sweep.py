@@ -939,12 +939,11 @@ class Sweeper:
             a, b, depth = todo.pop()
             cut: list[tuple] = []  # (edge, t_end, toward): traces ended by a neighbour's change
             done = pre.pop((a, b))
-            for (t, _), (edges, quads, ends, not_point, cut_short) in zip(
+            for (t, _), (edges, quads, ends, inside, not_point, cut_short) in zip(
                 ((a, b), (b, a)), done, strict=True
             ):
-                for e in frame(t)[1]:
-                    if e not in edges:  # swept inside the known shadows: nothing to trace
-                        cover.setdefault(e[1], []).append((a, b))
+                for e in inside:  # swept inside the known shadows: nothing to trace
+                    cover.setdefault(e[1], []).append((a, b))
                 for e in not_point:
                     traced.setdefault(e[1], []).append((a, b))
                 stats["edges"] += len(edges)
@@ -957,7 +956,7 @@ class Sweeper:
                     else:  # not confirmed even at its own sample: tracing cannot cover it
                         traced.setdefault(e[1], []).append((a, b))
                 cut += cut_short
-                confirmed.update((t, e[1]) for e in frame(t)[1] if e not in edges)
+                confirmed.update((t, e[1]) for e in inside)
             gap = self._coverage_gap(frame(a)[1], frame(b)[1], cover, a, b, confirmed)
             if gap is None:
                 gap = self._continuation_gap(cut, traced, probed, q0, dq)
@@ -969,10 +968,11 @@ class Sweeper:
     def _interval_traces(self, jobs: list[tuple]) -> list[dict[tuple[float, float], list]]:
         """Per job ``(q0, q1, frame, intervals)`` (a sweep ``q0 -> q1``, its frames, intervals
         ``(a, b)`` of its sample times), per interval: for the shadow edges at ``a`` traced
-        towards ``b``, then those at ``b`` towards ``a``, ``(edges, quads, ends, not_point,
-        cut)``: the edges whose sweep leaves the two samples' shadows
+        towards ``b``, then those at ``b`` towards ``a``, ``(edges, quads, ends, inside,
+        not_point, cut)``: the edges whose sweep leaves the two samples' shadows
         (:meth:`_uncovered_seen`, else :meth:`_uncovered`), what :meth:`_trace_many` makes
-        of them, the other edges that are no point (:meth:`_not_point`) and the traces cut
+        of them, the other edges (swept inside the known shadows), those of them that are
+        no point (:meth:`_not_point`) and the traces cut
         short (:meth:`_cut_short`); each of these in one batch over all the intervals (none
         depends on what the others covered)."""
         self._check_time()
@@ -1004,16 +1004,18 @@ class Sweeper:
             ([e for e in frame(t)[1] if e not in edges], t, q0, dq)
             for frame, (edges, t, _, q0, dq) in zip(frames, groups, strict=True)
         ]
-        points = self._not_point_many(inside)
+        points = self._not_point_many(inside)  # of the edges swept inside the known shadows
         cuts = self._cut_short_many(
             [(g[0], tr[1], *g[1:]) for g, tr in zip(groups, traces, strict=True)]
         )
-        got = iter(zip(groups, traces, points, cuts, strict=True))
+        got = iter(zip(groups, traces, inside, points, cuts, strict=True))
         out = []
         for _, _, _, intervals in jobs:
             done = {}
             for ab in intervals:
-                done[ab] = [(g[0], *tr, pt, ct) for g, tr, pt, ct in (next(got), next(got))]
+                done[ab] = [
+                    (g[0], *tr, ins[0], pt, ct) for g, tr, ins, pt, ct in (next(got), next(got))
+                ]
             out.append(done)
         return out
 
