@@ -73,10 +73,7 @@ def weak_visibility(
     if grz is not None:
         v, sectors, extra, arcs, _ = grz
         g, off = gaps_many(dom, v, sectors=sectors, extra=extra, flat=True)
-        sees = (g.seg >= 0) & (dom.seg_tag[np.maximum(g.seg, 0)] == WANTED)
-        if arcs is not None:
-            owner = np.searchsorted(off, np.arange(len(g.lo)), side="right") - 1
-            sees &= _grazes(arcs[owner], 0.5 * (g.lo + g.hi))
+        sees = _sees_wanted(dom, g.seg, g.lo, g.hi, off, arcs)
         back_q, back_sec = [], []
         for k in np.unique(np.searchsorted(off, np.flatnonzero(sees), side="right") - 1):
             gk = g.part(off[k], off[k + 1])
@@ -167,10 +164,8 @@ def corners_seeing(env: Domain, ring: np.ndarray) -> np.ndarray:
         return out
     v, sectors, extra, arcs, idx = grz
     g, off = gaps_many(dom, v, sectors=sectors, extra=extra, flat=True)
-    sees = (g.seg >= 0) & (dom.seg_tag[np.maximum(g.seg, 0)] == WANTED)
+    sees = _sees_wanted(dom, g.seg, g.lo, g.hi, off, arcs)
     owner = np.searchsorted(off, np.arange(len(g.lo)), side="right") - 1
-    if arcs is not None:
-        sees &= _grazes(arcs[owner], 0.5 * (g.lo + g.hi))
     sel = idx[np.bincount(owner[sees], minlength=len(v)) > 0]
     out[sel[sel < nv]] = True
     return out
@@ -250,6 +245,24 @@ def _between(arcs: np.ndarray, phi: np.ndarray, a: float) -> np.ndarray:
     with np.errstate(invalid="ignore"):
         hit = (((s1 - s0) % TAU) < w0 - eps) | (((s0 - s1) % TAU) < w1 - eps)
     return (hit & ~np.isnan(s1)).any(axis=1)
+
+
+def _sees_wanted(
+    dom: Domain,
+    seg: np.ndarray,
+    lo: np.ndarray,
+    hi: np.ndarray,
+    off: np.ndarray,
+    arcs: np.ndarray | None,
+) -> np.ndarray:
+    """Per gap of the grazing anchors' flat gaps (segment hit ``seg``, directions ``lo``,
+    ``hi``; anchor k owns gaps ``off[k] : off[k + 1]``): does the anchor see a wanted piece
+    of the target there, past its pinch arcs (``arcs``, :func:`_pinch_arcs`, or None)?"""
+    sees = (seg >= 0) & (dom.seg_tag[np.maximum(seg, 0)] == WANTED)
+    if arcs is not None:
+        owner = np.searchsorted(off, np.arange(len(lo)), side="right") - 1
+        sees &= _grazes(arcs[owner], 0.5 * (lo + hi))
+    return sees
 
 
 def _grazes(arcs: np.ndarray, phi: np.ndarray) -> np.ndarray:
@@ -628,12 +641,9 @@ def weak_visibility_many(
             if off[hi_v] == off[lo_v]:
                 continue
             g0, g1_ = off[lo_v], off[hi_v]
-            seg = g.seg[g0:g1_]
-            s_ = (seg >= 0) & (doms[r].seg_tag[np.maximum(seg, 0)] == WANTED)
-            if arcs is not None:
-                owner = np.searchsorted(off[lo_v : hi_v + 1] - g0, np.arange(g1_ - g0), "right") - 1
-                s_ &= _grazes(arcs[owner], 0.5 * (g.lo[g0:g1_] + g.hi[g0:g1_]))
-            sees[g0:g1_] = s_
+            sees[g0:g1_] = _sees_wanted(
+                doms[r], g.seg[g0:g1_], g.lo[g0:g1_], g.hi[g0:g1_], off[lo_v : hi_v + 1] - g0, arcs
+            )
         gi, bounds = _runs_flat(g, off, sees)
         if len(bounds) > 1:
             first, last = gi[bounds[:-1]], gi[bounds[1:] - 1]
