@@ -295,7 +295,7 @@ def _swept_frame_diff(seed: int, query: str, frame: str) -> float:
 #: shadow corner split by 6e-9 (below the labels' 8.6e-9): ``_drop_short`` kept the split's
 #: first vertex, off the next edge's line, so that edge got no label and its neighbour was
 #: dropped; the base frame, not the UTM one, missed 1.2e-4 D^2 of shadow (the corner is
-#: now where the two lines meet, ``sweep._corners``).  208530 (from the run of seeds
+#: now where the two lines meet, ``_sweep.shadow._corners``).  208530 (from the run of seeds
 #: 200000-209499) -- the end of a sliver obstacle (1.2e-8 across, below the labels'
 #: 1e-8 in each coordinate) merged into one corner: the next shadow edge was off its line
 #: by the sliver's width, unlabelled, and its neighbour not traced; the frames differed by
@@ -351,7 +351,7 @@ def test_split_corner_keeps_the_lines():
     203978: that vertex was 6e-9 off the next edge's line and the edge went unlabelled)."""
     import numpy as np
 
-    from geometry.sweep import _drop_short
+    from geometry._sweep.shadow import _drop_short
 
     corner = np.array([0.5587027499712555, 0.2339677110594749])
     ring = np.array(
@@ -375,7 +375,7 @@ def test_short_edge_between_environment_vertices_is_kept():
     keeps those two: the edges on either side stay on their own lines."""
     import numpy as np
 
-    from geometry.sweep import _drop_short
+    from geometry._sweep.shadow import _drop_short
 
     ring = np.array(
         [[0.4156265736128262, 0.34764151450872305], [0.4156265649726656, 0.34764152269413984],
@@ -459,7 +459,7 @@ def test_swept_inclusion_seeds(seed):
 #: blind stretch) where it sees no wanted point of the target.  203978: only the base
 #: frame held it.  208530: the base and the scaled frames held these (a sliver obstacle's
 #: end, 1.2e-8 across, merged into one corner that left the next shadow edge off its line
-#: by that much: unlabelled, not traced; ``sweep._corners`` keeps such an edge now).
+#: by that much: unlabelled, not traced; ``_sweep.shadow._corners`` keeps such an edge now).
 BLIND_5_2 = [
     (203978, (9.547096177088465, 4.700004951139725), None, (7.38208994, 2.08)),
     (208530, (5.335013768959447, 3.6823418261296497), (0, 0.405), None),

@@ -130,6 +130,7 @@ def test_sweeper_point_test_deduplicated_and_window_first_gives_the_row_by_row_a
     directions only for rows with a window into K (issue 10, speed); the answer must be
     the plain test of every row: windows and wanted directions of all rows overlapped."""
     import geometry.sweep as sweep
+    from geometry._sweep.blind import _overlaps
 
     got = []
     along_many = sweep.Sweeper.along_many
@@ -166,7 +167,7 @@ def test_sweeper_point_test_deduplicated_and_window_first_gives_the_row_by_row_a
     windows = sw._windows(pf, base, np.stack([base + lo, hi - lo], axis=1))
     wanted = sw._wanted_dirs(pf, qf, base)
     plain = np.zeros(len(p), dtype=bool)
-    plain[far] = ~sweep._overlaps(*windows, *wanted, len(pf))
+    plain[far] = ~_overlaps(*windows, *wanted, len(pf))
     assert 20 < plain.sum() < far.sum() - 20  # blind and seeing rows both tested
     assert len(np.unique(windows[2])) < far.sum()  # rows without a window occur
     np.testing.assert_array_equal(fast, plain)
@@ -177,13 +178,13 @@ def test_short_ring_edges_are_merged_before_labelling():
     edges; such an edge cannot be labelled and hid its neighbours from the tracing
     (fuzz seed 509765 lost a traced shadow of the 5.2 query), so ``_edges`` merges edges
     shorter than the labelling tolerance into a vertex, the closing edge included."""
-    from geometry.sweep import _drop_short
+    from geometry._sweep.shadow import _drop_short
 
     ring = np.array(
         [[0, 0], [1, 0], [1 + 1e-15, 3e-15], [1, 1], [0, 1], [2e-15, 1e-15]], dtype=float
     )
     out = _drop_short(ring, 1e-8)
-    # the split corners merge where the lines on either side meet (sweep._corners)
+    # the split corners merge where the lines on either side meet (geometry._sweep.shadow._corners)
     np.testing.assert_allclose(out, ring[[0, 1, 3, 4]], rtol=0, atol=1e-14)
     np.testing.assert_array_equal(_drop_short(out, 1e-8), out)
 

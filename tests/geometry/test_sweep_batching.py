@@ -13,6 +13,9 @@ import shapely
 
 from geometry import Scene, partial_region, recognizable_region
 from geometry import sweep as S
+from geometry._shapes import cross as _cross
+from geometry._sweep import shadow as SH
+from geometry._sweep.lines import _rot
 
 REPRO = Path(__file__).parent / "fuzz_repro"
 
@@ -34,8 +37,8 @@ def test_drop_short_matches_the_loop() -> None:
         k = rng.integers(0, 4)
         for i in rng.integers(0, len(v), size=k):  # short edges, incl. the closing one
             v[i] = v[i - 1] + 1e-9
-        got, ref = S._drop_short(v, 1e-6), _drop_short_loop(v, 1e-6)
-        # the same vertices kept, each moved at most to its split corner (sweep._corners)
+        got, ref = SH._drop_short(v, 1e-6), _drop_short_loop(v, 1e-6)
+        # the same vertices kept, each moved at most to its split corner (SH._corners)
         assert got.shape == ref.shape
         assert np.abs(got - ref).max() <= 4e-6
         assert int((np.abs(got - ref) > 0).any(axis=1).sum()) <= k
@@ -56,18 +59,18 @@ def test_drop_short_of_many_rings_is_ring_by_ring() -> None:
             for i in rng.integers(0, max(n, 1), size=rng.integers(0, 3)) if n else []:
                 v[i] = v[i - 1] + 1e-9  # a short step (the closing one when i == 0)
             rings.append(v)
-        got = S._drop_short_many(rings, 1e-6)
+        got = SH._drop_short_many(rings, 1e-6)
         for v, g in zip(rings, got, strict=True):
-            ref = S._drop_short(v, 1e-6)
+            ref = SH._drop_short(v, 1e-6)
             assert (g is v) == (ref is v)
             assert np.array_equal(g, ref)
             slow += g is not v
     assert slow > 50  # not vacuous: many rings took the slow path
     polys = shapely.buffer(shapely.points(rng.normal(size=(4, 2)) * 5), 1.0)
     shapely.prepare(polys)
-    rings = S._rings(shapely.difference(shapely.box(-20, -20, 20, 20), shapely.union_all(polys)))
+    rings = SH._rings(shapely.difference(shapely.box(-20, -20, 20, 20), shapely.union_all(polys)))
     assert len(rings) > 1
-    for r, c in zip(rings, S._ring_coords(rings), strict=True):
+    for r, c in zip(rings, SH._ring_coords(rings), strict=True):
         assert np.array_equal(c, np.asarray(r.coords)[:-1, :2])
 
 
@@ -91,8 +94,8 @@ def test_batched_labels_equal_ring_by_ring(monkeypatch) -> None:
     n_moving = 0
     for key in list(sw._frames)[:6]:
         shadow, table, tid = sw.shadow(np.asarray(key))
-        for ring in S._rings(shapely.orient_polygons(shadow, exterior_cw=False)):
-            v = S._drop_short(np.asarray(ring.coords)[:-1, :2], sw.tol_lab)
+        for ring in SH._rings(shapely.orient_polygons(shadow, exterior_cw=False)):
+            v = SH._drop_short(np.asarray(ring.coords)[:-1, :2], sw.tol_lab)
             one = sw._label(v, table, tid)
             d = np.roll(v, -1, axis=0) - v
             both = sw._label(np.vstack([v, v[::-1]]), table, tid, d=np.vstack([d, -d[::-1]]))
@@ -109,7 +112,7 @@ def _all_at_once(sw: S.Sweeper, vs, ve, ts, q0, dq) -> tuple[np.ndarray, np.ndar
     with np.errstate(divide="ignore", invalid="ignore"):
         u = d / ln[..., None]
     h = np.minimum(sw.h, 0.05 * ln)[..., None]
-    nrm = S._rot(u) * (1e-3 * h)
+    nrm = _rot(u) * (1e-3 * h)
     fixed = np.broadcast_to(np.arange(1, sw.probes) / sw.probes, ln.shape + (sw.probes - 1,))
     fr = np.concatenate([fixed, sw._between_lines(vs, d, ts, q0, dq)], axis=-1)
     eh = (h[..., 0] / np.where(ln > 0, ln, 1.0))[..., None]
@@ -155,9 +158,7 @@ def _unfiltered(sw: S.Sweeper) -> tuple[np.ndarray, ...]:
     bn = env.vert_next[env.reflex] - b
     i, j = np.triu_indices(len(b), 1)
     w = b[j] - b[i]
-    ok = (S._cross(w, bp[i]) * S._cross(w, bn[i]) >= 0) & (
-        S._cross(w, bp[j]) * S._cross(w, bn[j]) >= 0
-    )
+    ok = (_cross(w, bp[i]) * _cross(w, bn[i]) >= 0) & (_cross(w, bp[j]) * _cross(w, bn[j]) >= 0)
     return b, bp, bn, i[ok], j[ok]
 
 
@@ -187,11 +188,11 @@ def test_skipping_fixed_edges_keeps_the_labels(monkeypatch) -> None:
     for key in list(sw._frames)[:8]:
         shadow, table, tid = sw.shadow(np.asarray(key))
         fast = sw._edges(shadow, table, tid)
-        rings = S._rings(shapely.orient_polygons(shadow, exterior_cw=False))
+        rings = SH._rings(shapely.orient_polygons(shadow, exterior_cw=False))
         vs = [
             v
             for r in rings
-            if len(v := S._drop_short(np.asarray(r.coords)[:-1, :2], sw.tol_lab)) >= 3
+            if len(v := SH._drop_short(np.asarray(r.coords)[:-1, :2], sw.tol_lab)) >= 3
         ]
         off = np.cumsum([0] + [len(v) for v in vs])
         skipped += int(sw._fixed_edges(np.concatenate(vs), off).sum())
@@ -330,13 +331,16 @@ def test_batched_weak_visibility_is_the_one_by_one_answer(monkeypatch) -> None:
     from geometry.weak import weak_visibility, weak_visibility_many
 
     calls: list = []
-    orig = S.weak_visibility
+    from geometry._sweep import births as BI
+
+    orig = SH.weak_visibility
 
     def record(env, ring, wanted, eps=0.0, grazing=None):
         calls.append((env, ring, wanted, eps, grazing))
         return orig(env, ring, wanted, eps, grazing)
 
-    monkeypatch.setattr(S, "weak_visibility", record)
+    monkeypatch.setattr(SH, "weak_visibility", record)  # the samples and the corners
+    monkeypatch.setattr(BI, "weak_visibility", record)  # the eroded targets
     monkeypatch.setattr(S.Sweeper, "_prefetch", lambda self, qs, eroded=(): None)  # one by one here
     lab = Scene.load("sensorplan_gym/scenes/lab.json")
     partial_region(lab, target_in="goal", theta=0.0)
@@ -430,7 +434,7 @@ def test_lazy_bisection_stops_once_the_ends_stand_still(monkeypatch) -> None:
 
 
 def _drop_short_definition(v: np.ndarray, length: float) -> list[int]:
-    """The vertices :func:`geometry.sweep._drop_short` keeps, one by one: vertex i when it
+    """The vertices :func:`geometry._sweep.shadow._drop_short` keeps, one by one: vertex i when it
     lies at least ``length`` (max-norm) from the last kept vertex."""
     keep = [0]
     for i in range(1, len(v)):
@@ -454,8 +458,8 @@ def test_drop_short_keeps_the_vertices_of_its_definition() -> None:
         tail = len(v)
         while len(keep) > 1 and np.abs(v[keep[-1]] - v[0]).max() < length:
             tail = keep.pop()
-        want = v if len(keep) == len(v) else S._corners(v, keep, tail, length)
-        got = S._drop_short(v, length)
+        want = v if len(keep) == len(v) else SH._corners(v, keep, tail, length)
+        got = SH._drop_short(v, length)
         assert got.shape == want.shape and np.array_equal(got, want)
         clustered += len(keep) < len(v)
     assert clustered > 1000  # not vacuous: most rings have clusters
@@ -479,7 +483,7 @@ def test_corners_that_see_k_are_those_inside_its_weak_visibility_region(name, mo
     assert new.sum() > 0 and not (new & ~old).any()
     ring = sw.hull[::-1]
     seen = shapely.union(
-        S.weak_visibility(sw.env, ring, np.ones(len(ring), dtype=bool)), sw._hull_poly
+        SH.weak_visibility(sw.env, ring, np.ones(len(ring), dtype=bool)), sw._hull_poly
     )
     left = shapely.points(sw.env.vert[old & ~new])
     assert (shapely.distance(seen.boundary, left) <= 1e-6 * sw.env.scale).all()

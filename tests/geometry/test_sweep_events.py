@@ -18,6 +18,7 @@ from geometry import Scene, partial_region, recognizable_region
 from geometry import sweep as S
 from geometry._common import scene_domain
 from geometry._shapes import ccw_ring
+from geometry._shapes import cross as _cross
 from geometry.fuzz import fuzz_scene
 from sensorplan_gym.core.scenes import load_scene
 
@@ -133,7 +134,7 @@ def test_every_event_names_anchors_collinear_at_its_time(name, monkeypatch) -> N
                     if np.abs(p).max() > 1e3 * sw.env.scale:
                         continue  # the end of a wanted piece on a strip nearly parallel to it
                     span = np.abs(p - p[0]).max()
-                    cross = S._cross(p[1] - p[0], p[2] - p[0])
+                    cross = _cross(p[1] - p[0], p[2] - p[0])
                     assert abs(cross) <= 1e-6 * max(span, 1e-12) * sw.env.scale, (name, t, every)
                     checked += 1
     assert checked or name == "lab"

@@ -1,0 +1,286 @@
+"""The collinearity events of a sweep, and the samples taken next to the live ones.
+
+A moving anchor crossing the line through two obstacle corners (or an obstacle edge), or
+the line through two target vertices crossing a corner: there a shadow can be born as a
+segment continuing a known shadow edge.  Part of :class:`geometry.sweep.Sweeper`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import shapely
+
+from .._shapes import cross as _cross
+
+
+class CollinearityEvents:
+    """The collinearity events of a :class:`~geometry.sweep.Sweeper` (a mixin of it: it
+    uses the sweeper's scene, target and anchors): :meth:`_events` along a segment and
+    the samples :meth:`_live_mids` asks for next to them."""
+
+    def _live_mids(
+        self, ev_t: np.ndarray, ev_ids: list, frames: dict, looked: set[int]
+    ) -> list[float]:
+        """The sample times (sorted, not sampled yet) that the collinearity events
+        :meth:`_events` asks for now: the midpoint of each interval between consecutive
+        events (0 and 1 included) next to a live event that holds no sample yet.
+
+        An event (index into ``ev_t``) is *live* when a shadow edge at a sample so far
+        (``frames``: time -> (shadow, edges); the edge or one of its neighbours) lies on a
+        line spanned by two of its anchors, one of them moving (:meth:`_events`' ids; an
+        unknown id, -1, makes it live; ``lazy_samples=False``: the previous rule, the
+        midpoint of every interval between events, 0.5 on an edge without events).  The wedge
+        that opens at an event grows from a line that continues an edge of an existing
+        shadow, and that edge lies on such a line, so an event none of whose lines
+        carries a shadow edge at any sample opens no wedge *unless* that edge itself is
+        born and gone between samples: the rule assumes it is not (measured, not proven:
+        docs/DESIGN.md, "Collinearity events").  The caller samples, then asks again (the
+        new samples can make more events live); each event is looked at until it is live
+        once (``looked``)."""
+        bounds = np.concatenate([[0.0], ev_t, [1.0]])
+        if not self.lazy_samples:  # the previous rule: once between every two events, at once
+            if -1 in looked:
+                return []
+            looked.update([-1, *range(len(ev_t))])
+            return sorted({float(t) for t in 0.5 * (bounds[1:] + bounds[:-1])} - set(frames))
+        keys = {frozenset(k) for _, es in frames.values() for e in es for k in e}
+        times = np.array(sorted(frames))
+        out: set[float] = set()
+        for k in range(len(ev_t)):
+            if k in looked:
+                continue
+            live = False
+            for mov, other in ev_ids[k]:
+                if -1 in mov or -1 in other:
+                    live = True
+                    break
+                if any(frozenset((u, v)) in keys for u in mov for v in (*mov, *other) if v != u):
+                    live = True
+                    break
+            if not live:
+                continue
+            looked.add(k)
+            for lo, hi in ((bounds[k], bounds[k + 1]), (bounds[k + 1], bounds[k + 2])):
+                if not ((times > lo) & (times < hi)).any():
+                    out.add(float(0.5 * (lo + hi)))
+        return sorted(out)
+
+    def _events(self, q0: np.ndarray, dq: np.ndarray) -> tuple[np.ndarray, list]:
+        """Times in (0, 1), sorted, at which the target moving along ``q0 + t dq`` meets
+        a *collinearity event*: a moving anchor (target vertex or end of a wanted piece)
+        crosses the line through two convex obstacle corners whose joining line is
+        tangent at both, or through an obstacle edge; or the line through two target
+        vertices crosses a convex obstacle corner.  Only events whose line is
+        unobstructed between its anchors count.  Also, per time, the anchor ids of its
+        events: ``(moving ids, other ids)`` each (ids as :meth:`pos` takes them; -1: the
+        neighbour of an obstacle corner not known), for :meth:`_live_mids`.
+
+        At such an event two shadow-edge lines coincide, and a shadow can be born as a
+        segment on that line (it then grows from a line that continues an edge of an
+        existing shadow, so the eroded-target test of :meth:`_refine_births`, which
+        looks for shadow components apart from the known ones, does not see it: fuzz
+        issue 26.3/26.4).  Sampling once between consecutive events catches such a
+        shadow at a time it has area, and its edges are then traced both ways (next to
+        the events :meth:`_live_mids` finds live)."""
+        b, i, j = self._event_lines()
+        env = self.env
+        # obstacle edges with a convex end (a beam can graze along them past that end)
+        cvx = self._event_corners()
+        p0 = np.vstack([b[i], env.vert[cvx], env.vert[cvx]])
+        p1 = np.vstack([b[j], env.vert_next[cvx], env.vert_prev[cvx]])
+        w = p1 - p0
+        # moving anchors at t = 0 and their velocities (target vertices: dq; ends of the
+        # wanted pieces slide along their strip segment)
+        q0v = q0[None, :]
+        mov0 = [self.ring0 + q0v]
+        vel = [np.broadcast_to(dq, self.ring0.shape)]
+        if len(self._cut_segs):
+            ids = self.n_fixed + self.m + np.arange(len(self._cut_segs))
+            with np.errstate(invalid="ignore"):  # an edge parallel to its strip segment
+                c0 = self.pos(ids, np.repeat(q0v, len(ids), 0))
+                c1 = self.pos(ids, np.repeat((q0 + dq)[None, :], len(ids), 0))
+            ok = np.isfinite(c0).all(axis=1) & np.isfinite(c1).all(axis=1)
+            mov0.append(c0[ok])
+            vel.append(c1[ok] - c0[ok])
+        x0, vx = np.vstack(mov0), np.vstack(vel)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            # x0 + t vx on the line (p0, w)
+            ta = _cross(w[:, None, :], p0[:, None, :] - x0[None]) / _cross(w[:, None, :], vx[None])
+            ii, kk = np.triu_indices(self.m, 1)
+            wt = self.ring0[kk] - self.ring0[ii]
+            a0 = self.ring0 + q0v
+            tb = _cross(wt[None], b[:, None, :] - a0[ii][None]) / _cross(wt, dq)[None]
+        lo, hi = 1e-9, 1 - 1e-9
+        la, xa = np.nonzero(np.isfinite(ta) & (ta > lo) & (ta < hi))
+        ta = ta[la, xa]
+        lb, pb = np.nonzero(np.isfinite(tb) & (tb > lo) & (tb < hi))
+        tb = tb[lb, pb]
+        # unobstructed: the line's piece spanning its three points lies in the free space
+        xs = x0[xa] + ta[:, None] * vx[xa]
+        pts = np.stack([p0[la], p1[la], xs], axis=1)  # (A, 3, 2)
+        u = w[la] / np.maximum(np.hypot(w[la, 0], w[la, 1]), 1e-300)[:, None]
+        s_ = np.einsum("akj,aj->ak", pts - pts[:, :1], u)
+        seg_a = np.stack(
+            [
+                pts[np.arange(len(pts)), np.argmin(s_, axis=1)],
+                pts[np.arange(len(pts)), np.argmax(s_, axis=1)],
+            ],
+            axis=1,
+        )
+        ai = a0[ii[pb]] + tb[:, None] * dq
+        ak = a0[kk[pb]] + tb[:, None] * dq
+        bb = b[lb]
+        near = np.where((np.hypot(*(ai - bb).T) <= np.hypot(*(ak - bb).T))[:, None], ai, ak)
+        seg_b = np.stack([bb, near], axis=1)
+        segs = np.concatenate([seg_a, seg_b])
+        t = np.concatenate([ta, tb])
+        if len(t) == 0:
+            return t, []
+        keep = self._tangent_events(xa, ta, la, w, lb, pb, b, ii, kk)
+        idx = np.flatnonzero(keep)  # the covering test only where the tangency holds
+        keep[idx] = shapely.covers(self._free_near(), shapely.linestrings(segs[idx]))
+        cut = np.flatnonzero(xa >= self.m)  # ends of wanted pieces: on their edge then?
+        if len(cut):
+            k = xa[cut] - self.m
+            kk_ = np.flatnonzero(np.isfinite(c0).all(axis=1) & np.isfinite(c1).all(axis=1))[k]
+            i_e = self._cut_edge[kk_]
+            a_e = self.ring0[i_e] + q0 + ta[cut, None] * dq
+            e_e = self.edge0[i_e]
+            s_e = self._cut_segs[kk_]
+            x_e = xs[cut]
+            u_e = np.einsum("ij,ij->i", x_e - a_e, e_e) / np.einsum("ij,ij->i", e_e, e_e)
+            d_s = s_e[:, 2:] - s_e[:, :2]
+            w_e = np.einsum("ij,ij->i", x_e - s_e[:, :2], d_s) / np.maximum(
+                np.einsum("ij,ij->i", d_s, d_s), 1e-300
+            )
+            keep[cut] &= (u_e >= -1e-9) & (u_e <= 1 + 1e-9) & (w_e >= -1e-9) & (w_e <= 1 + 1e-9)
+        # the anchor ids of each event: the moving ones and the others (lines through two
+        # of them carry the edges of the wedge that opens there, see _live_mids)
+        n = self.n_fixed
+        mov_id = n + np.arange(self.m)
+        if len(self._cut_segs):
+            mov_id = np.concatenate([mov_id, n + self.m + np.flatnonzero(ok)])
+        nxt, prv = self._ring_neighbours()
+        fix = np.vstack(
+            [
+                np.stack([cvx[i], cvx[j]], axis=1),
+                np.stack([cvx, nxt[cvx]], axis=1),
+                np.stack([cvx, prv[cvx]], axis=1),
+            ]
+        )
+        ids = [((int(mov_id[x]),), tuple(fix[k].tolist())) for x, k in zip(xa, la, strict=True)]
+        ids += [
+            ((n + int(ii[p]), n + int(kk[p])), (int(cvx[k]),)) for p, k in zip(pb, lb, strict=True)
+        ]
+        kept = np.flatnonzero(keep)
+        kept = kept[np.argsort(t[kept], kind="stable")]
+        ts = t[kept]
+        # merge events closer than the tracing can tell apart (the first time stands)
+        first = np.concatenate([[True], np.diff(ts) > 1e-9]) if len(ts) else np.zeros(0, bool)
+        group = np.cumsum(first) - 1
+        out: list[list] = [[] for _ in range(int(first.sum()))]
+        for g, c in zip(group, kept, strict=True):
+            out[g].append(ids[c])
+        return ts[first], out
+
+    def _ring_neighbours(self) -> tuple[np.ndarray, np.ndarray]:
+        """(len(env.vert),) indices of each environment vertex's next and previous vertex
+        along its ring, -1 where the domain's rings are not stored one after the other
+        (cached)."""
+        got = getattr(self, "_neighbours", None)
+        if got is None:
+            env = self.env
+            r = np.asarray(env.vert_ring)
+            idx = np.arange(len(r))
+            nxt = np.full(len(r), -1)
+            prv = np.full(len(r), -1)
+            if len(r) and (np.diff(r) >= 0).all():
+                first = np.searchsorted(r, r, side="left")
+                last = np.searchsorted(r, r, side="right") - 1
+                n_ = np.where(idx == last, first, idx + 1)
+                p_ = np.where(idx == first, last, idx - 1)
+                ok_n = (env.vert[n_] == env.vert_next).all(axis=1)
+                ok_p = (env.vert[p_] == env.vert_prev).all(axis=1)
+                nxt[ok_n] = n_[ok_n]
+                prv[ok_p] = p_[ok_p]
+            got = self._neighbours = (nxt, prv)
+        return got
+
+    def _tangent_events(self, xa, ta, la, w, lb, pb, b, ii, kk) -> np.ndarray:
+        """Which events can bound a shadow: the moving vertex's line is tangent to the
+        target there (both ring neighbours on one side), the line through two target
+        vertices has the whole target on one side and grazes the obstacle at ``b``."""
+        m = self.m
+        keep_a = np.ones(len(ta), dtype=bool)
+        tv = xa < m
+        if tv.any():
+            k = xa[tv]
+            r0 = self.ring0
+            keep_a[tv] = _tangent(w[la[tv]], r0[(k - 1) % m] - r0[k], r0[(k + 1) % m] - r0[k])
+        wt = self.ring0[kk[pb]] - self.ring0[ii[pb]]
+        rel = self.ring0[None, :, :] - self.ring0[ii[pb]][:, None, :]
+        side = _cross(wt[:, None, :], rel)
+        zero = np.abs(side) <= 1e-9 * np.hypot(wt[:, 0], wt[:, 1])[:, None] * np.hypot(
+            rel[..., 0], rel[..., 1]
+        )
+        one_side = ~(((side > 0) & ~zero).any(axis=1) & ((side < 0) & ~zero).any(axis=1))
+        env = self.env
+        cvx = self._event_corners()
+        bp = env.vert_prev[cvx][lb] - b[lb]
+        bn = env.vert_next[cvx][lb] - b[lb]
+        graze = _tangent(wt, bp, bn)
+        return np.concatenate([keep_a, one_side & graze])
+
+    def _event_lines(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Convex obstacle corners and the pairs (i, j) of them whose joining line is
+        tangent at both, with collinear neighbours counting as tangent (cached).  Unlike
+        :meth:`_corners_and_tangents` the test has a tolerance: rows of collinear corners
+        and flush edges are where the events are, and a bare sign test there flips with
+        the rounding of the frame (fuzz seed 8103, scaled by 1e3)."""
+        got = getattr(self, "_ev_lines", None)
+        if got is None:
+            env = self.env
+            cvx = self._event_corners()
+            b = env.vert[cvx]
+            bp = env.vert_prev[cvx] - b
+            bn = env.vert_next[cvx] - b
+            i, j = np.triu_indices(len(b), 1)
+            w = b[j] - b[i]
+            ok = _tangent(w, bp[i], bn[i]) & _tangent(w, bp[j], bn[j])
+            got = self._ev_lines = (b, i[ok], j[ok])
+        return got
+
+    def _event_corners(self) -> np.ndarray:
+        """Indices of the environment vertices that anchor collinearity events: the convex
+        obstacle corners that see K (:meth:`_anchors`; cached).  An event counts only when
+        the line's piece spanning its anchors lies in the free space, and one of them is on
+        the target, inside K, so both corners of an event line see K (up to the free
+        space's ``tol_lab`` growth: a line that merely grazes an obstacle between a corner
+        and K is dropped with it; measured, see docs/DESIGN.md).  On office maps most
+        corners see no point of K, and the pairs of corners were most of the events' cost.
+        With ``lazy_samples=False`` (the previous rules): every convex corner."""
+        got = getattr(self, "_ev_corners", None)
+        if got is None:
+            keep = self.env.reflex & (self._anchors() if self.lazy_samples else True)
+            got = self._ev_corners = np.flatnonzero(keep)
+        return got
+
+    def _free_near(self) -> shapely.Geometry:
+        """The free space grown by ``tol_lab`` (cached, prepared): lines that graze
+        obstacles are unobstructed."""
+        got = getattr(self, "_free_grown", None)
+        if got is None:
+            got = self._free_grown = shapely.buffer(self.free, self.tol_lab)
+            shapely.prepare(got)
+        return got
+
+
+def _tangent(w: np.ndarray, bp: np.ndarray, bn: np.ndarray, rel: float = 1e-9) -> np.ndarray:
+    """Row by row: does the line of direction ``w`` through a corner keep the corner's
+    two edges (``bp``, ``bn``: from the corner to its neighbours) on one side?  An edge
+    within ``rel`` (relative sine) of the line counts as on it, i.e. on either side."""
+    cp, cn = _cross(w, bp), _cross(w, bn)
+    lw = np.hypot(w[..., 0], w[..., 1])
+    zp = np.abs(cp) <= rel * lw * np.hypot(bp[..., 0], bp[..., 1])
+    zn = np.abs(cn) <= rel * lw * np.hypot(bn[..., 0], bn[..., 1])
+    return zp | zn | (cp * cn > 0)

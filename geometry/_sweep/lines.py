@@ -1,0 +1,21 @@
+"""Lines and directions, row by row."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._shapes import cross as _cross
+
+
+def _meet(a0: np.ndarray, a1: np.ndarray, b0: np.ndarray, b1: np.ndarray) -> np.ndarray:
+    """Intersection of the lines (a0, a1) and (b0, b1), row by row (NaN if parallel)."""
+    da, db = a1 - a0, b1 - b0
+    den = _cross(da, db)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        s = _cross(b0 - a0, db) / den
+    return a0 + da * s[..., None]
+
+
+def _rot(v: np.ndarray) -> np.ndarray:
+    """``v`` (..., 2) turned by +90 degrees."""
+    return np.stack([-v[..., 1], v[..., 0]], axis=-1)
