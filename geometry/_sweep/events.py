@@ -11,6 +11,7 @@ import numpy as np
 import shapely
 
 from .._shapes import cross as _cross
+from .lines import _corner_pairs
 
 
 class CollinearityEvents:
@@ -239,13 +240,7 @@ class CollinearityEvents:
         the rounding of the frame (fuzz seed 8103, scaled by 1e3)."""
         got = getattr(self, "_ev_lines", None)
         if got is None:
-            env = self.env
-            cvx = self._event_corners()
-            b = env.vert[cvx]
-            bp = env.vert_prev[cvx] - b
-            bn = env.vert_next[cvx] - b
-            i, j = np.triu_indices(len(b), 1)
-            w = b[j] - b[i]
+            b, bp, bn, i, j, w = _corner_pairs(self.env, self._event_corners())
             ok = _tangent(w, bp[i], bn[i]) & _tangent(w, bp[j], bn[j])
             got = self._ev_lines = (b, i[ok], j[ok])
         return got

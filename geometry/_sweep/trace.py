@@ -13,7 +13,7 @@ import numpy as np
 import shapely
 
 from .._shapes import cross as _cross
-from .lines import _meet, _rot
+from .lines import _corner_pairs, _meet, _rot
 
 #: The bisection of a traced edge's death time tests this many levels of its binary
 #: tree of midpoints in one batch: see :meth:`EdgeTracing._bisect`.
@@ -299,12 +299,7 @@ class EdgeTracing:
         got = getattr(self, "_tangents", None)
         if got is None:
             env = self.env
-            sees = self._anchors()
-            b = env.vert[sees]
-            bp = env.vert_prev[sees] - b
-            bn = env.vert_next[sees] - b
-            i, j = np.triu_indices(len(b), 1)
-            w = b[j] - b[i]
+            b, bp, bn, i, j, w = _corner_pairs(env, self._anchors())
             ok = (_cross(w, bp[i]) * _cross(w, bn[i]) >= 0) & (
                 _cross(w, bp[j]) * _cross(w, bn[j]) >= 0
             )
