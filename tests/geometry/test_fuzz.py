@@ -18,8 +18,9 @@ import shapely
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from geometry import Scene, fuzz, partial_region, recognizable_region
+from geometry import Scene, partial_region, recognizable_region
 from geometry.fuzz import check_scene, fuzz_scene, run_many
+from geometry.fuzz.checks import _gap_points
 
 #: Seeds that failed before the fixes of issue 10 (each a different root cause):
 #: 27 and 37 -- output folded invalid by the rounding of the mapping back to world
@@ -203,7 +204,7 @@ def test_stationary_frame_seeds(seed):
 
 
 #: Contact-fuzz seeds whose stationary partial region failed the point tests of
-#: ``fuzz._check_partial_points`` before target contacts were made exact in
+#: ``geometry.fuzz.checks._check_partial_points`` before target contacts were made exact in
 #: ``weak.snap_to_boundary`` (issue 26 items 2, 5, 9): ``unsafe`` (members that see the
 #: target only through a sub-tolerance gap at a flush contact) 37, 42, 120, 144, 163, 216,
 #: 293; ``missed`` (placements seeing the exposed middle of a flush edge) 50, 223.  Then
@@ -263,7 +264,7 @@ def _swept_frame_diff(seed: int, query: str, frame: str) -> float:
     import shapely
 
     from geometry import partial_region
-    from geometry.fuzz import FRAMES, _mapped, _swept_differ
+    from geometry.fuzz.frames import FRAMES, _mapped, _swept_differ
 
     d = {k: v for k, v in fuzz_scene(seed, contacts=True).items() if k != "features"}
     s = Scene.from_dict(d)
@@ -485,7 +486,7 @@ def test_swept_5_2_frame_seed_excludes_a_blind_placement(seed, p, edge_t, q):
     import shapely
 
     from geometry._shapes import ccw_ring
-    from geometry.fuzz import _clear_lines
+    from geometry.fuzz.checks import _clear_lines
     from geometry.recognize import _accuracy, overlap_strips
 
     d = {k: v for k, v in fuzz_scene(seed, contacts=True).items() if k != "features"}
@@ -572,7 +573,7 @@ def test_fuzz_seed_300584_member_sees_through_a_pinhole():
     assert partial_region(s, target_at=q0).contains(shapely.Point(p))
     tgt = s.target_at(*q0)
     assert VisOracle(s).visibility(p).intersection(tgt).area > 0  # the pinhole is real
-    gap = fuzz._gap_points(s, 1e-3 * s.diameter)
+    gap = _gap_points(s, 1e-3 * s.diameter)
     a, b = (shapely.Polygon(o) for o in d["obstacles"][:2])
     assert len(gap) == 1 and 1e-7 < a.distance(b) < 2e-7
     # close the gap: the member no longer sees the target, nor is it in the region
@@ -597,7 +598,7 @@ def test_fuzz_seed_301059_flush_obstacle_keeps_its_wedge():
     import numpy as np
 
     from geometry import complete_region
-    from geometry.fuzz import _sample
+    from geometry.fuzz.checks import _sample
 
     VisOracle, _, s, q = _clean_seed(301059)
     tgt = s.target_at(*q)
