@@ -503,10 +503,10 @@ class Sweeper(StationaryShadows, PointTest, CollinearityEvents, Coverage, BirthC
         ``(a, b)`` of its sample times), per interval: for the shadow edges at ``a`` traced
         towards ``b``, then those at ``b`` towards ``a``, ``(edges, quads, ends, inside,
         not_point, cut)``: the edges whose sweep leaves the two samples' shadows
-        (:meth:`_uncovered_seen`, else :meth:`_uncovered`), what :meth:`_trace_many` makes
-        of them, the other edges (swept inside the known shadows), those of them that are
-        no point (:meth:`_not_point`) and the traces cut
-        short (:meth:`_cut_short`); each of these in one batch over all the intervals (none
+        (:meth:`_uncovered_seen_many`, else :meth:`_uncovered`), what :meth:`_trace_many`
+        makes of them, the other edges (swept inside the known shadows), those of them that
+        are no point (:meth:`_not_point_many`) and the traces cut short
+        (:meth:`_cut_short_many`); each of these in one batch over all the intervals (none
         depends on what the others covered)."""
         self._check_time()
         items = [
@@ -523,7 +523,7 @@ class Sweeper(StationaryShadows, PointTest, CollinearityEvents, Coverage, BirthC
                 # the areal part: GEOS's union of two nearly coincident shadows can carry
                 # collapsed edges (LineStrings), and an overlay with such a collection fails
                 # ("Result area inconsistent with overlay operation", fuzz seed 501057)
-                known = None  # the shadows' union, if their X (see _uncovered_seen) is not kept
+                known = None  # the shadows' union, if their X (_uncovered_seen_many) is not kept
                 for t, toward in ((a, b), (b, a)):
                     edges = next(seen)
                     if edges is None:

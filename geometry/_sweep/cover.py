@@ -15,7 +15,7 @@ from .._shapes import areal, snapped
 from .trace import _row_sweeps
 
 #: A traced edge that dies between samples while still this long relative to its length
-#: at its sample was cut short by a neighbour's change: see :meth:`Coverage._cut_short`.
+#: at its sample was cut short by a neighbour's change: see :meth:`Coverage._cut_short_many`.
 CUT_REL = 1e-3
 
 
@@ -69,12 +69,13 @@ class Coverage:
         need = ~ok | (rest > 1e-9 * self.env.scale**2)
         return [e for e, n_ in zip(edges, need, strict=True) if n_]
 
-    def _uncovered_seen(
-        self, edges: list, t: float, toward: float, ab: tuple[float, float], q0, q1
-    ) -> list | None:
-        """:meth:`_uncovered` for the shadows ``S_a``, ``S_b`` at the sample times ``ab``
-        from what they do not hold, ``X_a`` and ``X_b`` (:meth:`shadow`); None when one
-        of them was not kept (the caller then unites the shadows).
+    def _uncovered_seen_many(self, items: list[tuple]) -> list[list | None]:
+        """Per item ``(edges, t, toward, ab, q0, q1)``: :meth:`_uncovered` for the shadows
+        ``S_a``, ``S_b`` at the sample times ``ab`` of the sweep ``q0 -> q1``, from what they
+        do not hold, ``X_a`` and ``X_b`` (:meth:`shadow`); None when one of them was not kept
+        (the caller then unites the shadows).  The strips and the overlays of all items in one
+        batch (shapely's functions act element by element, so each item gets what it would
+        alone).
 
         ``S_a u S_b = F - (X_a n X_b)`` (``F`` the free space), so the part of a quad
         outside the known shadows is ``(quad - F) u (quad n X_a n X_b)``: one
@@ -85,12 +86,6 @@ class Coverage:
         width times ``F``'s perimeter), which the threshold is lowered by, so no sweep
         that :meth:`_uncovered` would trace is dropped; ``quad n X_a n X_b`` is not cut by
         ``F`` (that area is only larger)."""
-        return self._uncovered_seen_many([(edges, t, toward, ab, q0, q1)])[0]
-
-    def _uncovered_seen_many(self, items: list[tuple]) -> list[list | None]:
-        """:meth:`_uncovered_seen` for each item ``(edges, t, toward, ab, q0, q1)``, the strips
-        and the overlays of all items in one batch (shapely's functions act element by
-        element, so each item gets what it would alone)."""
         out: list[list | None] = [None] * len(items)
         todo, inters = [], []
         for k, (edges, _, _, ab, q0, q1) in enumerate(items):
@@ -162,17 +157,13 @@ class Coverage:
             got = self._free_eps = (grown, 2.0 * eps * float(shapely.length(self.free)))
         return got
 
-    def _cut_short(self, edges: list, ends: list, t: float, toward: float, q0, dq) -> list:
-        """``(edge, t_end, toward)`` for the traced ``edges`` whose trace from ``t`` ended
-        at ``t_end`` strictly between ``t`` and ``toward`` while the edge still had length
-        (at least ``CUT_REL`` of its length at ``t``): not a shadow edge that shrank to a
-        point, but one whose neighbouring edge died, so that its line goes on bounding the
-        shadow with another neighbour (:meth:`_continuation_gap`)."""
-        return self._cut_short_many([(edges, ends, t, toward, q0, dq)])[0]
-
     def _cut_short_many(self, items: list[tuple]) -> list[list]:
-        """:meth:`_cut_short` for each item ``(edges, ends, t, toward, q0, dq)``, the ends in
-        one batch."""
+        """Per item ``(edges, ends, t, toward, q0, dq)``: ``(edge, t_end, toward)`` for the
+        traced ``edges`` whose trace from ``t`` ended at ``t_end`` (``ends``) strictly between
+        ``t`` and ``toward`` while the edge still had length (at least ``CUT_REL`` of its
+        length at ``t``): not a shadow edge that shrank to a point, but one whose neighbouring
+        edge died, so that its line goes on bounding the shadow with another neighbour
+        (:meth:`_continuation_gap`).  The ends of all items in one batch."""
         out: list[list] = [[] for _ in items]
         picks = []  # (item, its indices)
         for k, (_, ends, t, toward, _, _) in enumerate(items):
@@ -201,14 +192,11 @@ class Coverage:
                 r += 1
         return out
 
-    def _not_point(self, edges: list, t: float, q0, dq) -> list:
-        """The ``edges`` longer than ``1e-6`` of the scene's size at time ``t``: a shadow
-        edge that is a point there (its neighbours' lines meet on its own) sweeps nothing
-        in any configuration and tells nothing of the line's other configurations."""
-        return self._not_point_many([(edges, t, q0, dq)])[0]
-
     def _not_point_many(self, items: list[tuple]) -> list[list]:
-        """:meth:`_not_point` for each item ``(edges, t, q0, dq)``, the ends in one batch."""
+        """Per item ``(edges, t, q0, dq)``: the ``edges`` longer than ``1e-6`` of the scene's
+        size at time ``t``.  A shadow edge that is a point there (its neighbours' lines meet
+        on its own) sweeps nothing in any configuration and tells nothing of the line's other
+        configurations.  The ends of all items in one batch."""
         out: list[list] = [[] for _ in items]
         live = [k for k, it in enumerate(items) if it[0]]
         if not live:
@@ -226,10 +214,10 @@ class Coverage:
         return out
 
     def _continuation_gap(self, cut: list, traced: dict, probed: list, q0, dq) -> float | None:
-        """A time just after a trace was cut short (:meth:`_cut_short`) at ``t_end``
+        """A time just after a trace was cut short (:meth:`_cut_short_many`) at ``t_end``
         where the cut edge's line still bounds a shadow and no trace of that line has
         reached (nor an edge on it found swept inside the known shadows,
-        :meth:`_not_point`, or one that the exact point test does not confirm even at
+        :meth:`_not_point_many`, or one that the exact point test does not confirm even at
         its own sample: see :meth:`_coverage_gap`), or None.
 
         When a neighbouring edge dies, the edge's line goes on bounding the shadow with

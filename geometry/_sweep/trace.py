@@ -184,11 +184,6 @@ class EdgeTracing:
             steps -= levels
         return t_ok, t_bad
 
-    def _ends(self, edge, ts: np.ndarray, q0, dq) -> tuple[np.ndarray, np.ndarray]:
-        """Start and end points of one shadow edge at times ``ts``."""
-        a, b = self._ends_many([edge], np.asarray(ts)[None, :], q0, dq)
-        return a[0], b[0]
-
     def _ends_many(self, edges: list, ts: np.ndarray, q0, dq) -> tuple[np.ndarray, np.ndarray]:
         """Start and end points of shadow edges (E) at times ``ts`` (E, T) or (1, T)."""
         k = np.asarray(edges, dtype=np.int64)  # (E, 3, 2)

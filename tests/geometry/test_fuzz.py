@@ -444,7 +444,7 @@ def test_label_wants_the_edge_on_the_pair_line():
 #: swept inside the known shadows, from the quadrilateral of its first and last positions
 #: (``Sweeper._strips`` now follows its ends on the tracing grid); 204155 -- a shadow edge
 #: whose neighbour died went on with another neighbour, a configuration born and gone
-#: between two samples (``Sweeper._cut_short``, ``_continuation_gap``).
+#: between two samples (``Sweeper._cut_short_many``, ``_continuation_gap``).
 SWEPT_INCLUSION_SEEDS = [203869, 204155]
 
 
