@@ -192,6 +192,7 @@ def gaps_many(
     extra: np.ndarray | None = None,
     flat: bool = False,
     interior: bool = False,
+    ends: bool = True,
 ) -> list[Gaps] | tuple[Gaps, np.ndarray]:
     """:func:`gaps_from` for many viewpoints at once (one vectorised ray cast).
 
@@ -200,7 +201,8 @@ def gaps_many(
     entries ignored).
 
     ``interior=True`` promises that no viewpoint lies on the boundary (it skips
-    the local-obstruction test).
+    the local-obstruction test).  ``ends=False``: the caller needs no boundary points,
+    ``p0`` and ``p1`` are NaN (the ray-segment intersections are not computed).
 
     Returns one :class:`Gaps` per viewpoint, or with ``flat=True`` all gaps in
     one :class:`Gaps` (``q`` then holds one row per gap) plus the (n+1,) offsets
@@ -222,17 +224,21 @@ def gaps_many(
     else:
         owner, lo, hi = _sorted_gaps(q, start, width, dom.vert, crit, tol, interior)
     mid = 0.5 * (lo + hi)
-    open_ = _unblocked(mid, owner, w1, w2, along)
+    # an interior viewpoint has no blocking wedge: every gap is open (the test's NaN rows)
+    open_ = np.ones(len(mid), dtype=bool) if interior else _unblocked(mid, owner, w1, w2, along)
     qo = q[owner]
     seg = np.full(len(mid), -1, dtype=np.int64)
     idx = np.flatnonzero(open_)
     for c in range(0, len(idx), 2048):
         part = idx[c : c + 2048]
         seg[part] = _first_hits(dom, qo[part], mid[part])
-    p0 = qo.copy()
-    p1 = qo.copy()
+    if not ends:
+        p0 = p1 = np.full_like(qo, np.nan)
+    else:
+        p0 = qo.copy()
+        p1 = qo.copy()
     ok = seg >= 0
-    if ok.any():
+    if ends and ok.any():
         sg = dom.seg[seg[ok]]
         p0[ok] = _ray_line(qo[ok], lo[ok], sg)
         p1[ok] = _ray_line(qo[ok], hi[ok], sg)

@@ -163,7 +163,7 @@ def corners_seeing(env: Domain, ring: np.ndarray) -> np.ndarray:
     if grz is None:
         return out
     v, sectors, extra, arcs, idx = grz
-    g, off = gaps_many(dom, v, sectors=sectors, extra=extra, flat=True)
+    g, off = gaps_many(dom, v, sectors=sectors, extra=extra, flat=True, ends=False)
     sees = _sees_wanted(dom, g.seg, g.lo, g.hi, off, arcs)
     owner = np.searchsorted(off, np.arange(len(g.lo)), side="right") - 1
     sel = idx[np.bincount(owner[sees], minlength=len(v)) > 0]

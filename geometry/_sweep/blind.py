@@ -75,7 +75,7 @@ class PointTest:
     def _windows(self, p: np.ndarray, base: np.ndarray, sectors: np.ndarray) -> tuple:
         """Directions (relative to ``base``) inside ``sectors`` (start, width) in
         which each p sees into K."""
-        g, off = gaps_many(self.env, p, sectors=sectors, flat=True, interior=True)
+        g, off = gaps_many(self.env, p, sectors=sectors, flat=True, interior=True, ends=False)
         own = np.repeat(np.arange(len(p)), np.diff(off))
         ok = g.seg >= 0
         g_lo, g_hi, own, seg = g.lo[ok], g.hi[ok], own[ok], g.seg[ok]

@@ -351,3 +351,28 @@ def test_visibility_polygon_of_a_point_in_a_room_with_a_pillar():
         shapely.box(1.5, 1.5, 2.5, 2.5)
     )
     assert abs(v.area - (free.area - hidden.area)) < 1e-9
+
+
+def test_gaps_without_their_end_points_are_the_same_gaps():
+    """``gaps_many(..., ends=False)`` (the sweep's point test, the corners that see K) skips
+    the rays' boundary points, and ``interior=True`` the blocking test: the gaps (directions,
+    segments hit) are those of the full call, the end points NaN."""
+    from geometry._common import scene_domain
+    from geometry._vis import gaps_many
+
+    lab = Scene.load("sensorplan_gym/scenes/lab.json")
+    dom = scene_domain(lab)
+    rng = np.random.default_rng(5)
+    x0, y0, x1, y1 = lab.free_space.bounds
+    p = rng.uniform([x0, y0], [x1, y1], (600, 2))
+    p = p[shapely.contains_xy(lab.free_space, p[:, 0], p[:, 1])][:300]
+    n = len(p)
+    sectors = np.stack([rng.uniform(-np.pi, np.pi, n), rng.uniform(0.1, 2 * np.pi, n)], axis=1)
+    full, off = gaps_many(dom, p, sectors=sectors, flat=True)
+    for interior in (False, True):
+        bare, off2 = gaps_many(dom, p, sectors=sectors, flat=True, interior=interior, ends=False)
+        np.testing.assert_array_equal(off2, off)
+        for k in ("q", "lo", "hi", "seg"):
+            np.testing.assert_array_equal(getattr(bare, k), getattr(full, k))
+        assert np.isnan(bare.p0).all() and np.isnan(bare.p1).all()
+    assert n > 200 and (full.seg >= 0).sum() > 1000 and np.isfinite(full.p0).all()
