@@ -20,6 +20,9 @@ in the same run (the anchor), with the exact stationary shadows ("samples") each
   samples its refinements add;
 * *union*: the union of the pieces.
 
+and, as a diagnostic, the whole swept query with the samples next to the collinearity events
+switched off (what a sweep carrying the shadow edges across the events could at most gain).
+
 The table says which parts a faster sweep has to change: the issue-25 target (10x the
 stationary query) is below the cost of the vertex samples plus the birth checks plus the
 tracing on the office maps.  Data (``swept_phases.json``) and fragment (``swept_phases.md``) go
@@ -32,9 +35,11 @@ from __future__ import annotations
 import statistics
 import time
 from typing import Any
+from unittest import mock
 
 from geometry import partial_region
 from geometry.partial import _swept_region
+from geometry.sweep import Sweeper
 
 from .real_maps import SLOW_REPROS, _cases, _pose, cli
 
@@ -51,7 +56,11 @@ PHASES = {
 
 def run(reps: int, slow: bool = True) -> dict[str, Any]:
     """Per scene: the stationary partial query's median seconds, the swept query's median
-    total and per-phase seconds, and its samples per phase."""
+    total and per-phase seconds, its samples per phase, and (``no_events_s``, a diagnostic)
+    the swept query's median seconds with the samples next to the collinearity events
+    switched off: the most a sweep that carried the shadow edges across the events for free
+    could gain (that sweep would keep the samples' safety net; this one drops it, so its
+    regions can miss the born-and-gone shadows of the fuzz reproductions)."""
     rows = []
     for name, _src, load, theta in _cases():
         if not slow and name in SLOW_REPROS:
@@ -75,6 +84,14 @@ def run(reps: int, slow: bool = True) -> dict[str, Any]:
             if k:
                 runs.append((total, sink["stats"]))
         stats = runs[0][1]
+        bare = []
+        with mock.patch.object(Sweeper, "_live_mids", lambda self, *a: []):
+            for k in range(reps + 1):
+                s = load()
+                t0 = time.perf_counter()
+                _swept_region(s, "goal", theta, 0.0, 0.0, None, False)
+                if k:
+                    bare.append(time.perf_counter() - t0)
         row = {
             "scene": name,
             "edges": edges,
@@ -87,6 +104,7 @@ def run(reps: int, slow: bool = True) -> dict[str, Any]:
             "rest_s": statistics.median(t - sum(st["seconds"].values()) for t, st in runs),
             "phase_samples": {p: stats["phase_samples"].get(p, 0) for p in PHASES},
             "samples": sum(stats["phase_samples"].values()),
+            "no_events_s": statistics.median(bare),
         }
         rows.append(row)
         print(
@@ -106,8 +124,8 @@ def render(data: dict[str, Any]) -> str:
     lines = [
         "| scene | edges | stationary partial | swept over G | "
         + " | ".join(PHASES.values())
-        + " | rest |",
-        "| --- | ---: | ---: | ---: |" + " ---: |" * (len(PHASES) + 1),
+        + " | rest | without event samples |",
+        "| --- | ---: | ---: | ---: |" + " ---: |" * (len(PHASES) + 2),
     ]
     for r in data["rows"]:
         st = r["stationary_s"]
@@ -121,6 +139,7 @@ def render(data: dict[str, Any]) -> str:
             n = r["phase_samples"][p]
             cells.append(f"{r['phase_s'][p] / st:.1f}x" + (f" ({n})" if n else ""))
         cells.append(f"{r['rest_s'] / st:.1f}x")
+        cells.append(f"{r['no_events_s'] / st:.1f}x")
         lines.append("| " + " | ".join(cells) + " |")
     m = data["machine"]
     lines += [
@@ -130,7 +149,10 @@ def render(data: dict[str, Any]) -> str:
         "the same scene in the same run (its median in the third column; the phases' medians "
         "need not add up to the query's); in parentheses the exact "
         "stationary shadows (samples) the phase took; *rest*: the query's own work around the "
-        "sweep (the scene's domain, the final difference). G a regular pentagon on the real "
+        "sweep (the scene's domain, the final difference); *without event samples*: the whole "
+        "swept query with the samples next to the collinearity events switched off (a "
+        "diagnostic: the bound on what carrying the edges across the events could gain; its "
+        "regions lack the events' safety net). G a regular pentagon on the real "
         "maps; `slow_1`, `slow_2` the independent fuzzer's reproductions with their own G, "
         f"target and orientation; {m['cpus']} CPUs, Python {m['python']}, load average "
         f"{m['load_average']}.",

@@ -17,6 +17,8 @@ def test_one_scene_runs_and_renders(monkeypatch) -> None:
     # every sample belongs to one phase; G's five vertices are sampled first
     assert row["phase_samples"]["vertex samples"] == 5
     assert row["samples"] == sum(row["phase_samples"].values())
+    assert 0 < row["no_events_s"]
     data.update(command="python -m benchmarks.swept_phases", machine=rm._results.machine())
     text = sp.render(data)
     assert text.count("\n| lse_arena | 14 |") == 1
+    assert text.splitlines()[0].endswith("| rest | without event samples |")
