@@ -78,17 +78,34 @@ def _check_frames(
     (``poly_gh``) the 5.2 recognizable region (issue 25 item 7), compared up to their
     tracing tolerance ``tol`` (1e-4 D, :func:`_swept_differ`)."""
     D = s.diameter
-    sw: list[tuple[str, Callable]] = []
+
+    def exact(a: shapely.Geometry, b: shapely.Geometry) -> float:
+        return shapely.symmetric_difference(a, b).area
+
+    def traced(a: shapely.Geometry, b: shapely.Geometry) -> float:
+        return _swept_differ(a, b, 1e-4 * D)
+
+    # (name, query of a scene and the pose's reference point, how regions are compared)
+    queries: list[tuple[str, Callable, Callable]] = [
+        ("complete at", lambda sc, x, y: complete_region(sc, target_at=(x, y, theta)), exact),
+        ("partial at", lambda sc, x, y: partial_region(sc, target_at=(x, y, theta)), exact),
+        ("complete in", lambda sc, x, y: complete_region(sc, target_in="goal", theta=theta), exact),
+    ]
     if swept and len(s.goal) > 1:
-        sw.append(("partial in", lambda sc: partial_region(sc, target_in="goal", theta=theta)))
+        swept_in = lambda sc, x, y: partial_region(sc, target_in="goal", theta=theta)  # noqa: E731
+        queries.append(("partial in", swept_in, traced))
     if swept and poly_gh:
-        sw.append(
-            ("recognizable 5.2", lambda sc: recognizable_region(sc, model="partial", theta=theta))
+        queries.append(
+            (
+                "recognizable 5.2",
+                lambda sc, x, y: recognizable_region(sc, model="partial", theta=theta),
+                traced,
+            )
         )
-    base = {}
-    for name, fn in sw:
+    base = {}  # each query once in the scene's own frame
+    for name, fn, _ in queries:
         try:
-            base[name] = fn(s)
+            base[name] = fn(s, q_at[0], q_at[1])
         except (SceneError, NotImplementedError):
             continue
         except Exception as e:  # noqa: BLE001
@@ -104,13 +121,10 @@ def _check_frames(
             out.append(Finding("frame", f"validation ({fname})", str(e)))
             continue
         qx, qy = q_at[0] * k + ox, q_at[1] * k + oy
-        for name, fn in (
-            ("complete at", lambda sc, x, y: complete_region(sc, target_at=(x, y, theta))),
-            ("partial at", lambda sc, x, y: partial_region(sc, target_at=(x, y, theta))),
-            ("complete in", lambda sc, x, y: complete_region(sc, target_in="goal", theta=theta)),
-        ):
+        for name, fn, differ in queries:
+            if name not in base:
+                continue
             try:
-                a = fn(s, q_at[0], q_at[1])
                 b = fn(t, qx, qy)
             except (SceneError, NotImplementedError):
                 continue
@@ -118,20 +132,6 @@ def _check_frames(
                 out.append(Finding("crash", f"{name} ({fname})", f"{type(e).__name__}: {e}"))
                 continue
             back = shapely.transform(b, lambda c, k=k, ox=ox, oy=oy: (c - [ox, oy]) / k)
-            diff = shapely.symmetric_difference(a, back).area
-            if diff > 1e-7 * D * D:
-                out.append(Finding("frame", f"{name} ({fname})", f"{diff / D**2:.3g} D^2"))
-        for name, fn in sw:
-            if name not in base:
-                continue
-            try:
-                b = fn(t)
-            except (SceneError, NotImplementedError):
-                continue
-            except Exception as e:  # noqa: BLE001
-                out.append(Finding("crash", f"{name} ({fname})", f"{type(e).__name__}: {e}"))
-                continue
-            back = shapely.transform(b, lambda c, k=k, ox=ox, oy=oy: (c - [ox, oy]) / k)
-            diff = _swept_differ(base[name], back, 1e-4 * D)
+            diff = differ(base[name], back)
             if diff > 1e-7 * D * D:
                 out.append(Finding("frame", f"{name} ({fname})", f"{diff / D**2:.3g} D^2"))
