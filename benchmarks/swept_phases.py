@@ -20,8 +20,10 @@ in the same run (the anchor), with the exact stationary shadows ("samples") each
   samples its refinements add;
 * *union*: the union of the pieces.
 
-and, as a diagnostic, the whole swept query with the samples next to the collinearity events
-switched off (what a sweep carrying the shadow edges across the events could at most gain).
+and, as diagnostics, the whole swept query with the samples next to the collinearity events
+switched off (what a sweep carrying the shadow edges across the events could at most gain),
+and with the birth checks switched off as well (the sweep without either safety net: G's
+vertex samples, the tracing between them and the union, the floor of this sweep's design).
 
 The table says which parts a faster sweep has to change: the issue-25 target (10x the
 stationary query) is below the cost of the vertex samples plus the birth checks plus the
@@ -32,13 +34,16 @@ to ``--out`` (default ``runs/benchmarks/swept_phases/``) or, with ``--update-res
 
 from __future__ import annotations
 
+import contextlib
 import statistics
 import time
 from typing import Any
 from unittest import mock
 
+import shapely
+
 from geometry import partial_region
-from geometry.partial import _swept_region
+from geometry.partial import _swept_region, swept_tol
 from geometry.sweep import Sweeper
 
 from .real_maps import SLOW_REPROS, _cases, _pose, cli
@@ -56,11 +61,14 @@ PHASES = {
 
 def run(reps: int, slow: bool = True) -> dict[str, Any]:
     """Per scene: the stationary partial query's median seconds, the swept query's median
-    total and per-phase seconds, its samples per phase, and (``no_events_s``, a diagnostic)
+    total and per-phase seconds, its samples per phase, and two diagnostics: ``no_events_s``,
     the swept query's median seconds with the samples next to the collinearity events
-    switched off: the most a sweep that carried the shadow edges across the events for free
-    could gain (that sweep would keep the samples' safety net; this one drops it, so its
-    regions can miss the born-and-gone shadows of the fuzz reproductions)."""
+    switched off (the most a sweep that carried the shadow edges across the events for free
+    could gain; that sweep would keep the samples' safety net, this one drops it, so its
+    regions can miss the born-and-gone shadows of the fuzz reproductions), and ``bare_s``,
+    with the birth checks switched off too (G's vertex samples, the tracing and the union
+    alone: what this sweep costs without either safety net), and ``bare_depth_tol``, how far
+    apart that sweep's conservative region and the full one are (:func:`_depth`)."""
     rows = []
     for name, _src, load, theta in _cases():
         if not slow and name in SLOW_REPROS:
@@ -84,14 +92,9 @@ def run(reps: int, slow: bool = True) -> dict[str, Any]:
             if k:
                 runs.append((total, sink["stats"]))
         stats = runs[0][1]
-        bare = []
-        with mock.patch.object(Sweeper, "_live_mids", lambda self, *a: []):
-            for k in range(reps + 1):
-                s = load()
-                t0 = time.perf_counter()
-                _swept_region(s, "goal", theta, 0.0, 0.0, None, False)
-                if k:
-                    bare.append(time.perf_counter() - t0)
+        no_events = _timed(load, theta, reps, births=True)
+        bare = _timed(load, theta, reps, births=False)
+        depth = _depth(load, theta)
         row = {
             "scene": name,
             "edges": edges,
@@ -104,7 +107,9 @@ def run(reps: int, slow: bool = True) -> dict[str, Any]:
             "rest_s": statistics.median(t - sum(st["seconds"].values()) for t, st in runs),
             "phase_samples": {p: stats["phase_samples"].get(p, 0) for p in PHASES},
             "samples": sum(stats["phase_samples"].values()),
-            "no_events_s": statistics.median(bare),
+            "no_events_s": no_events,
+            "bare_s": bare,
+            "bare_depth_tol": depth,
         }
         rows.append(row)
         print(
@@ -118,14 +123,61 @@ def run(reps: int, slow: bool = True) -> dict[str, Any]:
     return {"reps": reps, "rows": rows}
 
 
+def _timed(load, theta: float, reps: int, *, births: bool) -> float:
+    """Median seconds of the swept query over G (``reps`` calls after a warm-up, each on a
+    freshly loaded scene) with the samples next to the collinearity events switched off and,
+    unless ``births``, the birth checks too."""
+    times = []
+    with contextlib.ExitStack() as stack:
+        for patch in _off(births):
+            stack.enter_context(patch)
+        for k in range(reps + 1):
+            s = load()
+            t0 = time.perf_counter()
+            _swept_region(s, "goal", theta, 0.0, 0.0, None, False)
+            if k:
+                times.append(time.perf_counter() - t0)
+    return statistics.median(times)
+
+
+def _off(births: bool) -> list:
+    """The patches that switch the event samples off and, unless ``births``, the birth
+    checks too."""
+    off = [mock.patch.object(Sweeper, "_live_mids", lambda self, *a: [])]
+    if not births:
+        off += [
+            mock.patch.object(Sweeper, "_birth_bounds", lambda self, level: ([], {})),
+            mock.patch.object(Sweeper, "_refine_births_many", lambda self, *a, **k: None),
+        ]
+    return off
+
+
+def _depth(load, theta: float) -> float:
+    """How far apart the conservative swept regions over G with and without the safety nets
+    (event samples, birth checks) are, in ``tol``: the largest distance of a vertex of either
+    one's part outside the other from the other (0: equal)."""
+    kw = {"theta": theta, "timeout": None, "conservative": True}
+    full = partial_region(load(), target_in="goal", **kw)
+    with contextlib.ExitStack() as stack:
+        for patch in _off(births=False):
+            stack.enter_context(patch)
+        bare = partial_region(load(), target_in="goal", **kw)
+    out = 0.0
+    for a, b in ((full, bare), (bare, full)):
+        pts = shapely.get_coordinates(shapely.difference(a, b))
+        if len(pts):
+            out = max(out, float(shapely.distance(b, shapely.points(pts)).max()))
+    return out / swept_tol(load(), None)
+
+
 def render(data: dict[str, Any]) -> str:
     """The page fragment: per scene the phases as multiples of the stationary partial query
     (samples in parentheses)."""
     lines = [
         "| scene | edges | stationary partial | swept over G | "
         + " | ".join(PHASES.values())
-        + " | rest | without event samples |",
-        "| --- | ---: | ---: | ---: |" + " ---: |" * (len(PHASES) + 2),
+        + " | rest | without event samples | without event samples or birth checks |",
+        "| --- | ---: | ---: | ---: |" + " ---: |" * (len(PHASES) + 3),
     ]
     for r in data["rows"]:
         st = r["stationary_s"]
@@ -140,6 +192,9 @@ def render(data: dict[str, Any]) -> str:
             cells.append(f"{r['phase_s'][p] / st:.1f}x" + (f" ({n})" if n else ""))
         cells.append(f"{r['rest_s'] / st:.1f}x")
         cells.append(f"{r['no_events_s'] / st:.1f}x")
+        depth = r["bare_depth_tol"]
+        far = "0" if depth == 0 else "<0.01" if depth < 0.01 else f"{depth:.2g}"
+        cells.append(f"{r['bare_s'] / st:.1f}x ({far} tol)")
         lines.append("| " + " | ".join(cells) + " |")
     m = data["machine"]
     lines += [
@@ -152,7 +207,10 @@ def render(data: dict[str, Any]) -> str:
         "sweep (the scene's domain, the final difference); *without event samples*: the whole "
         "swept query with the samples next to the collinearity events switched off (a "
         "diagnostic: the bound on what carrying the edges across the events could gain; its "
-        "regions lack the events' safety net). G a regular pentagon on the real "
+        "regions lack the events' safety net); *without event samples or birth checks*: the birth "
+        "checks switched off as well (the same kind of diagnostic: G's vertex samples, the tracing "
+        "and the union alone, the floor of this sweep's design; in parentheses how far its "
+        "conservative region lies from the full one's, in `tol`). G a regular pentagon on the real "
         "maps; `slow_1`, `slow_2` the independent fuzzer's reproductions with their own G, "
         f"target and orientation; {m['cpus']} CPUs, Python {m['python']}, load average "
         f"{m['load_average']}.",
