@@ -138,6 +138,8 @@ class CollinearityEvents:
         if len(t) == 0:
             return t, []
         keep = self._tangent_events(xa, ta, la, w, lb, pb, b, ii, kk)
+        if self.lazy_samples:  # (the previous rules keep them)
+            keep[: len(ta)] &= ~_between(s_, la < len(i), self.tol_lab)
         idx = np.flatnonzero(keep)  # the covering test only where the tangency holds
         keep[idx] = shapely.covers(self._free_near(), shapely.linestrings(segs[idx]))
         cut = np.flatnonzero(xa >= self.m)  # ends of wanted pieces: on their edge then?
@@ -279,3 +281,14 @@ def _tangent(w: np.ndarray, bp: np.ndarray, bn: np.ndarray, rel: float = 1e-9) -
     zp = np.abs(cp) <= rel * lw * np.hypot(bp[..., 0], bp[..., 1])
     zn = np.abs(cn) <= rel * lw * np.hypot(bn[..., 0], bn[..., 1])
     return zp | zn | (cp * cn > 0)
+
+
+def _between(s_: np.ndarray, pair: np.ndarray, tol: float) -> np.ndarray:
+    """Per event of a moving anchor x on the line of two corners: is x strictly between the
+    corners (``s_``: (A, 3) positions of the two corners and x along the line; ``pair``: the
+    line is through two corners, not along an obstacle edge)?  Then the edges on the lines
+    (x, corner) are rays from each corner away from x, on opposite sides of x: neither
+    continues the other, and no wedge opens there."""
+    lo = np.minimum(s_[:, 0], s_[:, 1]) + tol
+    hi = np.maximum(s_[:, 0], s_[:, 1]) - tol
+    return pair & (s_[:, 2] > lo) & (s_[:, 2] < hi)

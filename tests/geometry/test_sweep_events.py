@@ -19,6 +19,7 @@ from geometry import sweep as S
 from geometry._common import scene_domain
 from geometry._shapes import ccw_ring
 from geometry._shapes import cross as _cross
+from geometry._sweep import events as E
 from geometry.fuzz import fuzz_scene
 from sensorplan_gym.core.scenes import load_scene
 
@@ -66,6 +67,14 @@ def _depth(a: shapely.Geometry, b: shapely.Geometry) -> float:
     """How far the part of ``a`` outside ``b`` reaches from ``b`` (its vertices' distance)."""
     pts = shapely.get_coordinates(a.difference(b))
     return float(shapely.distance(b, shapely.points(pts)).max()) if len(pts) else 0.0
+
+
+def _assert_close(name: str, got: dict, ref: dict) -> None:
+    """Every region of ``got`` within 2 tol of the same query's in ``ref`` (both ways)."""
+    tol = 1e-4 * _scene(name).diameter
+    for q in ref:
+        deep = max(_depth(got[q], ref[q]), _depth(ref[q], got[q]))
+        assert deep <= 2 * tol, f"{name} {q}: {deep / tol:.3g} tol apart"
 
 
 def _with_rule(lazy: bool, fn, monkeypatch):
@@ -284,10 +293,7 @@ def test_events_from_the_corners_that_see_k_give_the_regions_of_every_corner(
     with monkeypatch.context() as m:
         m.setattr(S.Sweeper, "__post_init__", every_corner)
         every, made_every = _run(name, monkeypatch, lazy=True)
-    tol = 1e-4 * _scene(name).diameter
-    for q in every:
-        deep = max(_depth(lazy[q], every[q]), _depth(every[q], lazy[q]))
-        assert deep <= 2 * tol, f"{name} {q}: {deep / tol:.3g} tol apart"
+    _assert_close(name, lazy, every)
     for sw, sw_every in zip(made, made_every, strict=True):
         keys = list(sw._frames)
         for q0, q1 in zip(keys[:-1], keys[1:], strict=True):
@@ -355,3 +361,52 @@ def test_a_convex_targets_eroded_part_is_the_intersection_of_the_ends() -> None:
     both = shapely.intersection(shapely.Polygon(ell), shapely.Polygon(ell + [-1.0, 1.0]))
     assert both.area > 0.1  # the ends overlap ...
     assert got is None or got[0].area < both.area - 1e-6  # ... but the notch sweeps over it
+
+
+@pytest.mark.parametrize("name", ["real/willow_north", "fuzz:200011"])
+def test_events_with_the_target_between_their_corners_are_dropped(name, monkeypatch) -> None:
+    """A target vertex crossing the line of two corners *between* them opens no wedge (the
+    edges on its lines are rays from each corner away from the vertex, on opposite sides of
+    it): the lazy rules drop such events (:func:`geometry._sweep.events._between`).  Every
+    event dropped has its moving vertex strictly between the two corners at its time
+    (checked here from the positions), the regions are those of the lazy rules keeping them
+    (within 2 tol), with fewer samples on ``willow_north``."""
+    ev = S.Sweeper._events
+    dropped: list[tuple] = []
+
+    def spy(self, q0, dq):
+        ts, ids = ev(self, q0, dq)
+        with monkeypatch.context() as m:  # the same sweeper keeping them
+            m.setattr(E, "_between", lambda s_, pair, tol: np.zeros(len(s_), dtype=bool))
+            for attr in ("_ev_lines", "_ev_corners"):
+                self.__dict__.pop(attr, None)
+            all_ts, all_ids = ev(self, q0, dq)
+        kept = {(round(float(t), 12), tuple(map(tuple, i))) for t, i in zip(ts, ids, strict=True)}
+        for t, evs in zip(all_ts, all_ids, strict=True):
+            for mov, other in evs:
+                if not any(abs(t - k[0]) <= 1e-9 and (mov, other) in k[1] for k in kept):
+                    dropped.append((self, q0 + t * dq, mov, other))
+        return ts, ids
+
+    with monkeypatch.context() as m:
+        m.setattr(S.Sweeper, "_events", spy)
+        lazy, made = _run(name, monkeypatch, lazy=True)
+    between = 0
+    for sw, q, mov, other in dropped:
+        if len(mov) != 1 or len(other) != 2 or min(other) < 0:
+            continue
+        x, c1, c2 = sw.pos(np.array([*mov, *other]), np.repeat(q[None], 3, axis=0))
+        s = float(np.dot(x - c1, c2 - c1) / np.dot(c2 - c1, c2 - c1))
+        if abs(_cross(c2 - c1, x - c1)) <= 1e-6 * sw.env.scale**2:
+            assert 0.0 < s < 1.0, (name, q, mov, other, s)
+            between += 1
+    assert between >= 1  # not vacuous
+    with monkeypatch.context() as m:
+        m.setattr(E, "_between", lambda s_, pair, tol: np.zeros(len(s_), dtype=bool))
+        kept, made_kept = _run(name, monkeypatch, lazy=True)
+    _assert_close(name, lazy, kept)
+    n_lazy = sum(len(sw._frames) for sw in made)
+    n_kept = sum(len(sw._frames) for sw in made_kept)
+    assert n_lazy <= n_kept
+    if name == "real/willow_north":
+        assert n_lazy < n_kept

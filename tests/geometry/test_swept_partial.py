@@ -292,9 +292,12 @@ def test_swept_region_properties():
         for x, y in np.asarray(sc.goal_geom.exterior.coords)[:-1]:
             still = partial_region(sc, target_at=(x, y, 0.0))
             assert loose.difference(still).area <= 1e-9 * sc.diameter**2
-        # a coarser tolerance moves the answer by at most about that tolerance
-        coarse = partial_region(sc, target_in="goal", theta=0.0, tol=100 * tol)
-        assert shapely.hausdorff_distance(coarse, loose, densify=0.05) < 0.05 * sc.diameter
+        # a coarser tolerance moves the answer by at most about that tolerance; compared on
+        # the conservative regions: the loose ones hold cracks between the traced quads and
+        # the samples (zero-width parts, up to several metres long here) that lie elsewhere
+        # with other samples, and the Hausdorff distance measures how far those reach
+        coarse = partial_region(sc, target_in="goal", theta=0.0, tol=100 * tol, conservative=True)
+        assert shapely.hausdorff_distance(coarse, cons, densify=0.05) < 3 * 100 * tol
 
 
 def test_swept_bad_input_is_named():
