@@ -72,7 +72,9 @@ class CollinearityEvents:
         crosses the line through two convex obstacle corners whose joining line is
         tangent at both, or through an obstacle edge; or the line through two target
         vertices crosses a convex obstacle corner.  Only events whose line is
-        unobstructed between its anchors count.  Also, per time, the anchor ids of its
+        unobstructed between its anchors count, and with the lazy rules not those whose
+        moving anchor lies between the two corners (:func:`_between`: no wedge opens
+        there).  Also, per time, the anchor ids of its
         events: ``(moving ids, other ids)`` each (ids as :meth:`pos` takes them; -1: the
         neighbour of an obstacle corner not known), for :meth:`_live_mids`.
 
