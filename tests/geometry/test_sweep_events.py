@@ -396,10 +396,12 @@ def test_events_with_the_target_between_their_corners_are_dropped(name, monkeypa
         if len(mov) != 1 or len(other) != 2 or min(other) < 0:
             continue
         x, c1, c2 = sw.pos(np.array([*mov, *other]), np.repeat(q[None], 3, axis=0))
+        if np.abs(x).max() > 1e3 * sw.env.scale:
+            continue  # the end of a wanted piece on a strip nearly parallel to it
+        assert abs(_cross(c2 - c1, x - c1)) <= 1e-6 * sw.env.scale**2, (name, q, mov, other)
         s = float(np.dot(x - c1, c2 - c1) / np.dot(c2 - c1, c2 - c1))
-        if abs(_cross(c2 - c1, x - c1)) <= 1e-6 * sw.env.scale**2:
-            assert 0.0 < s < 1.0, (name, q, mov, other, s)
-            between += 1
+        assert 0.0 < s < 1.0, (name, q, mov, other, s)
+        between += 1
     assert between >= 1  # not vacuous
     with monkeypatch.context() as m:
         m.setattr(E, "_between", lambda s_, pair, tol: np.zeros(len(s_), dtype=bool))
