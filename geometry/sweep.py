@@ -146,10 +146,11 @@ class _Run:
     q0: np.ndarray
     q1: np.ndarray
     frames: dict[float, tuple] = field(default_factory=dict)
-    looked: set[int] = field(default_factory=set)
+    looked: set[tuple[int, int]] = field(default_factory=set)
     stats: dict[str, int] = field(default_factory=lambda: {"samples": 0, "edges": 0, "refined": 0})
     ev_t: np.ndarray = field(default_factory=lambda: np.zeros(0))
     ev_ids: list = field(default_factory=list)
+    ev_side: list = field(default_factory=list)
 
     def __post_init__(self) -> None:
         self.dq = self.q1 - self.q0
@@ -394,9 +395,12 @@ class Sweeper(StationaryShadows, PointTest, CollinearityEvents, Coverage, BirthC
         # first from the samples alone, then again after the refinements of the tracing
         with clock("event samples"):
             for r in moving:
-                r.ev_t, r.ev_ids = self._events(r.q0, r.dq)
+                r.ev_t, r.ev_ids, r.ev_side = self._events(r.q0, r.dq)
             while True:
-                asked = [(r, self._live_mids(r.ev_t, r.ev_ids, r.frames, r.looked)) for r in moving]
+                asked = [
+                    (r, self._live_mids(r.ev_t, r.ev_ids, r.frames, r.looked, r.ev_side))
+                    for r in moving
+                ]
                 asked = [(r, mids) for r, mids in asked if mids]
                 if not asked:
                     break
@@ -430,7 +434,7 @@ class Sweeper(StationaryShadows, PointTest, CollinearityEvents, Coverage, BirthC
         while True:
             self._sweep_intervals(todo, q0, q1, frame, pieces, state, stats, pre)
             pre = None
-            mids = self._live_mids(run.ev_t, run.ev_ids, run.frames, run.looked)
+            mids = self._live_mids(run.ev_t, run.ev_ids, run.frames, run.looked, run.ev_side)
             if not mids:
                 return pieces
             self._prefetch([q0 + t * dq for t in mids])

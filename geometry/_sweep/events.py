@@ -20,7 +20,7 @@ class CollinearityEvents:
     the samples :meth:`_live_mids` asks for next to them."""
 
     def _live_mids(
-        self, ev_t: np.ndarray, ev_ids: list, frames: dict, looked: set[int]
+        self, ev_t: np.ndarray, ev_ids: list, frames: dict, looked: set, ev_side: list | None = None
     ) -> list[float]:
         """The sample times (sorted, not sampled yet) that the collinearity events
         :meth:`_events` asks for now: the midpoint of each interval between consecutive
@@ -35,38 +35,39 @@ class CollinearityEvents:
         shadow, and that edge lies on such a line, so an event none of whose lines
         carries a shadow edge at any sample opens no wedge *unless* that edge itself is
         born and gone between samples: the rule assumes it is not (measured, not proven:
-        docs/DESIGN.md, "Collinearity events").  The caller samples, then asks again (the
-        new samples can make more events live); each event is looked at until it is live
-        once (``looked``)."""
+        docs/DESIGN.md, "Collinearity events").  ``ev_side`` (:meth:`_events`), per anchor
+        tuple of ``ev_ids``: the sides of the event (-1 before, 1 after) where its wedge can
+        be a shadow, whose intervals a live event has sampled (None: both).  The caller
+        samples, then asks again (the new samples can make more events live); each side of
+        an event is looked at until it is live once (``looked``: ``(event, side)``)."""
         bounds = np.concatenate([[0.0], ev_t, [1.0]])
         if not self.lazy_samples:  # the previous rule: once between every two events, at once
-            if -1 in looked:
+            if looked:
                 return []
-            looked.update([-1, *range(len(ev_t))])
+            looked.add((-1, 0))
             return sorted({float(t) for t in 0.5 * (bounds[1:] + bounds[:-1])} - set(frames))
         keys = {frozenset(k) for _, es in frames.values() for e in es for k in e}
         times = np.array(sorted(frames))
         out: set[float] = set()
         for k in range(len(ev_t)):
-            if k in looked:
+            if (k, -1) in looked and (k, 1) in looked:
                 continue
-            live = False
-            for mov, other in ev_ids[k]:
-                if -1 in mov or -1 in other:
-                    live = True
-                    break
-                if any(frozenset((u, v)) in keys for u in mov for v in (*mov, *other) if v != u):
-                    live = True
-                    break
-            if not live:
-                continue
-            looked.add(k)
-            for lo, hi in ((bounds[k], bounds[k + 1]), (bounds[k + 1], bounds[k + 2])):
+            sides: set[int] = set()
+            for a, (mov, other) in enumerate(ev_ids[k]):
+                if (
+                    -1 in mov
+                    or -1 in other
+                    or any(frozenset((u, v)) in keys for u in mov for v in (*mov, *other) if v != u)
+                ):
+                    sides.update((-1, 1) if ev_side is None else ev_side[k][a])
+            for side in sorted(sides - {s for e, s in looked if e == k}):
+                looked.add((k, side))
+                lo, hi = (bounds[k], bounds[k + 1]) if side < 0 else (bounds[k + 1], bounds[k + 2])
                 if not ((times > lo) & (times < hi)).any():
                     out.add(float(0.5 * (lo + hi)))
         return sorted(out)
 
-    def _events(self, q0: np.ndarray, dq: np.ndarray) -> tuple[np.ndarray, list]:
+    def _events(self, q0: np.ndarray, dq: np.ndarray) -> tuple[np.ndarray, list, list]:
         """Times in (0, 1), sorted, at which the target moving along ``q0 + t dq`` meets
         a *collinearity event*: a moving anchor (target vertex or end of a wanted piece)
         crosses the line through two convex obstacle corners whose joining line is
@@ -76,7 +77,11 @@ class CollinearityEvents:
         moving anchor lies between the two corners (:func:`_between`: no wedge opens
         there).  Also, per time, the anchor ids of its
         events: ``(moving ids, other ids)`` each (ids as :meth:`pos` takes them; -1: the
-        neighbour of an obstacle corner not known), for :meth:`_live_mids`.
+        neighbour of an obstacle corner not known), and per event the sides of it (-1 before,
+        1 after) where its wedge can be a shadow (:meth:`_wedge_side`; with the whole outline
+        wanted, none for a line of two target vertices crossing a corner: of a point in the
+        wedge, the sight lines to the two vertices pass the corner on opposite sides, and
+        the one on the free side reaches the target), for :meth:`_live_mids`.
 
         At such an event two shadow-edge lines coincide, and a shadow can be born as a
         segment on that line (it then grows from a line that continues an edge of an
@@ -138,7 +143,7 @@ class CollinearityEvents:
         segs = np.concatenate([seg_a, seg_b])
         t = np.concatenate([ta, tb])
         if len(t) == 0:
-            return t, []
+            return t, [], []
         keep = self._tangent_events(xa, ta, la, w, lb, pb, b, ii, kk)
         if self.lazy_samples:  # (the previous rules keep them)
             keep[: len(ta)] &= ~_between(s_, la < len(i), self.tol_lab)
@@ -177,6 +182,14 @@ class CollinearityEvents:
         ids += [
             ((n + int(ii[p]), n + int(kk[p])), (int(cvx[k]),)) for p, k in zip(pb, lb, strict=True)
         ]
+        # the sides of each event where its wedge can be a shadow (the previous rules, and
+        # the 5.2 sweeps, whose wanted pieces these arguments do not cover: either side)
+        side = np.zeros(len(t), dtype=int)
+        if self.lazy_samples and self.strips is None:
+            k = np.flatnonzero(keep)
+            side[k] = self._wedge_sides(
+                k, len(ta), xa, la, w, s_, vx, segs, pb, lb, cvx, i, j, ii, kk
+            )
         kept = np.flatnonzero(keep)
         kept = kept[np.argsort(t[kept], kind="stable")]
         ts = t[kept]
@@ -184,9 +197,98 @@ class CollinearityEvents:
         first = np.concatenate([[True], np.diff(ts) > 1e-9]) if len(ts) else np.zeros(0, bool)
         group = np.cumsum(first) - 1
         out: list[list] = [[] for _ in range(int(first.sum()))]
+        sides: list[list] = [[] for _ in out]
         for g, c in zip(group, kept, strict=True):
             out[g].append(ids[c])
-        return ts[first], out
+            sides[g].append(_SIDES[int(side[c])])
+        return ts[first], out, sides
+
+    def _wedge_sides(
+        self, k, n_a, xa, la, w, s_, vx, segs, pb, lb, cvx, i, j, ii, kk
+    ) -> np.ndarray:
+        """The side codes (see ``_SIDES``) of the events ``k`` (indices into :meth:`_events`'
+        arrays: the first ``n_a`` of the first kind, a moving anchor on a line of two corners
+        or of an obstacle edge; the rest of the second kind, the line of two target vertices
+        through a corner; the other arguments as there), with the whole outline wanted.
+
+        Where the event's corners are *lone* (each has both its edges strictly off the
+        line, and no other obstacle edge comes within ``1e-6`` of the scene's size of the
+        line's piece spanning the three anchors), a sight line close to the line is blocked
+        near the event only at a corner it passes on that corner's obstacle side, and
+        reaches the target otherwise.  A point p in the wedge the event opens (beyond the
+        corner farthest from the target, between the two lines through it) has two such
+        sight lines, to the two anchors on the target's side, passing that corner on
+        opposite sides:
+
+        * second kind (target vertices a_n, a_f through corner b): one of them passes b on
+          its free side and reaches the target, so p is not blind and no shadow opens:
+          neither side;
+        * first kind (target vertex x, corners b_n nearer x and b_f), corners of obstacles
+          on opposite sides of the line: the sight line to x passes b_n and b_f on opposite
+          sides, so it is blocked only while it passes b_n on its obstacle's side, i.e.
+          while x is on that side of the line: the side of the event where x is;
+        * otherwise (the line of an obstacle edge, both obstacles on one side, corners not
+          lone): either side."""
+        out = np.zeros(len(k), dtype=int)
+        ka, kb = k[k < n_a], k[k >= n_a]
+        ka = ka[(la[ka] < len(i)) & (xa[ka] < self.m)]  # two corners, a target vertex
+        if len(ka) + len(kb) == 0:
+            return out
+        pair = la[ka]
+        corners = np.concatenate(
+            [
+                np.stack([cvx[i[pair]], cvx[j[pair]]], axis=1),
+                np.stack([cvx[lb[kb - n_a]], cvx[lb[kb - n_a]]], axis=1),
+            ]
+        )
+        p, q = pb[kb - n_a], self.ring0
+        lines = np.concatenate([w[pair], q[kk[p]] - q[ii[p]]])
+        rows = np.concatenate([ka, kb])
+        s0 = self._obstacle_side(corners[:, 0], lines)
+        s1 = self._obstacle_side(corners[:, 1], lines)
+        lone = (s0 != 0) & (s1 != 0) & self._clear(segs[rows], corners)
+        na = len(ka)
+        # second kind: neither side
+        out[np.isin(k, kb[lone[na:]])] = _NEITHER
+        # first kind: obstacles on opposite sides; x on the near corner's side after it
+        sel = lone[:na] & (s0[:na] == -s1[:na])
+        if sel.any():
+            ks = ka[sel]
+            near_i = np.abs(s_[ks, 0] - s_[ks, 2]) <= np.abs(s_[ks, 1] - s_[ks, 2])
+            s_near = np.where(near_i, s0[:na][sel], s1[:na][sel])
+            after = _side(lines[:na][sel], vx[xa[ks]])
+            code = np.where(after == 0, 0, np.where(after == s_near, 1, -1))
+            out[np.searchsorted(k, ks)] = code
+        return out
+
+    def _obstacle_side(self, v: np.ndarray, w: np.ndarray) -> np.ndarray:
+        """Per row: the side (1 left, -1 right) of the line of direction ``w`` through the
+        environment vertex ``v`` where both its edges lie, 0 where one lies on the line
+        (:func:`_side`) or they lie on both sides."""
+        env = self.env
+        sp = _side(w, env.vert_prev[v] - env.vert[v])
+        sn = _side(w, env.vert_next[v] - env.vert[v])
+        return np.where(sp == sn, sp, 0)
+
+    def _clear(self, segs: np.ndarray, corners: np.ndarray) -> np.ndarray:
+        """Per row: does no obstacle edge but those at the environment vertices
+        ``corners[r]`` come within ``1e-6`` of the scene's size of the segment
+        ``segs[r]`` ((N, 2, 2))?"""
+        got = getattr(self, "_edge_tree", None)
+        env = self.env
+        if got is None:
+            lines = shapely.linestrings(env.seg.reshape(-1, 2, 2))
+            got = self._edge_tree = shapely.STRtree(lines)
+        r, e = got.query(shapely.linestrings(segs), predicate="dwithin", distance=1e-6 * env.scale)
+        ends = env.seg[e].reshape(-1, 2, 2)
+        at = env.vert[corners[r]]  # (H, 2, 2): the row's two corners
+        own = (ends[:, :, None, :] == at[:, None, :, :]).all(axis=3).any(axis=(1, 2))
+        out = np.ones(len(segs), dtype=bool)
+        out[r[~own]] = False
+        # each corner's own two edges, no more (another ring touching at the corner)
+        distinct = 1 + (corners[:, 0] != corners[:, 1])
+        out &= np.bincount(r[own], minlength=len(segs)) <= 2 * distinct
+        return out
 
     def _ring_neighbours(self) -> tuple[np.ndarray, np.ndarray]:
         """(len(env.vert),) indices of each environment vertex's next and previous vertex
@@ -283,6 +385,21 @@ def _tangent(w: np.ndarray, bp: np.ndarray, bn: np.ndarray, rel: float = 1e-9) -
     zp = np.abs(cp) <= rel * lw * np.hypot(bp[..., 0], bp[..., 1])
     zn = np.abs(cn) <= rel * lw * np.hypot(bn[..., 0], bn[..., 1])
     return zp | zn | (cp * cn > 0)
+
+
+#: the codes of :meth:`CollinearityEvents._events`' sides: either side, only after, only
+#: before, neither
+_NEITHER = 2
+_SIDES = {0: (-1, 1), 1: (1,), -1: (-1,), _NEITHER: ()}
+
+
+def _side(w: np.ndarray, v: np.ndarray, rel: float = 1e-9) -> np.ndarray:
+    """Row by row: the side (1 left, -1 right) of the line of direction ``w`` that the
+    vector ``v`` points to, 0 within ``rel`` (relative sine) of the line (as :func:`_tangent`)."""
+    c = _cross(w, v)
+    lw = np.hypot(w[..., 0], w[..., 1])
+    zero = np.abs(c) <= rel * lw * np.hypot(v[..., 0], v[..., 1])
+    return np.where(zero, 0, np.sign(c)).astype(int)
 
 
 def _between(s_: np.ndarray, pair: np.ndarray, tol: float) -> np.ndarray:

@@ -11,9 +11,9 @@ def _meet(a0: np.ndarray, a1: np.ndarray, b0: np.ndarray, b1: np.ndarray) -> np.
     """Intersection of the lines (a0, a1) and (b0, b1), row by row (NaN if parallel)."""
     da, db = a1 - a0, b1 - b0
     den = _cross(da, db)
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore"):  # parallel: inf * 0 = NaN
         s = _cross(b0 - a0, db) / den
-    return a0 + da * s[..., None]
+        return a0 + da * s[..., None]
 
 
 def _rot(v: np.ndarray) -> np.ndarray:
