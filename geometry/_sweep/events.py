@@ -138,9 +138,10 @@ class CollinearityEvents:
         ai = a0[ii[pb]] + tb[:, None] * dq
         ak = a0[kk[pb]] + tb[:, None] * dq
         bb = b[lb]
-        near = np.where((np.hypot(*(ai - bb).T) <= np.hypot(*(ak - bb).T))[:, None], ai, ak)
-        seg_b = np.stack([bb, near], axis=1)
+        first = (np.hypot(*(ai - bb).T) <= np.hypot(*(ak - bb).T))[:, None]
+        seg_b = np.stack([bb, np.where(first, ai, ak)], axis=1)  # to the nearer vertex
         segs = np.concatenate([seg_a, seg_b])
+        spans = np.concatenate([seg_a, np.stack([bb, np.where(first, ak, ai)], axis=1)])
         t = np.concatenate([ta, tb])
         if len(t) == 0:
             return t, [], []
@@ -188,7 +189,7 @@ class CollinearityEvents:
         if self.lazy_samples and self.strips is None:
             k = np.flatnonzero(keep)
             side[k] = self._wedge_sides(
-                k, len(ta), xa, la, w, s_, vx, segs, pb, lb, cvx, i, j, ii, kk
+                k, len(ta), xa, la, w, s_, vx, spans, pb, lb, cvx, i, j, ii, kk
             )
         kept = np.flatnonzero(keep)
         kept = kept[np.argsort(t[kept], kind="stable")]
@@ -204,16 +205,17 @@ class CollinearityEvents:
         return ts[first], out, sides
 
     def _wedge_sides(
-        self, k, n_a, xa, la, w, s_, vx, segs, pb, lb, cvx, i, j, ii, kk
+        self, k, n_a, xa, la, w, s_, vx, spans, pb, lb, cvx, i, j, ii, kk
     ) -> np.ndarray:
         """The side codes (see ``_SIDES``) of the events ``k`` (indices into :meth:`_events`'
         arrays: the first ``n_a`` of the first kind, a moving anchor on a line of two corners
         or of an obstacle edge; the rest of the second kind, the line of two target vertices
-        through a corner; the other arguments as there), with the whole outline wanted.
+        through a corner; ``spans``: the segment spanning each event's three anchors; the
+        other arguments as there), with the whole outline wanted.
 
         Where the event's corners are *lone* (each has both its edges strictly off the
         line, and no other obstacle edge comes within ``1e-6`` of the scene's size of the
-        line's piece spanning the three anchors), a sight line close to the line is blocked
+        segment spanning the three anchors), a sight line close to the line is blocked
         near the event only at a corner it passes on that corner's obstacle side, and
         reaches the target otherwise.  A point p in the wedge the event opens (beyond the
         corner farthest from the target, between the two lines through it) has two such
@@ -246,7 +248,7 @@ class CollinearityEvents:
         rows = np.concatenate([ka, kb])
         s0 = self._obstacle_side(corners[:, 0], lines)
         s1 = self._obstacle_side(corners[:, 1], lines)
-        lone = (s0 != 0) & (s1 != 0) & self._clear(segs[rows], corners)
+        lone = (s0 != 0) & (s1 != 0) & self._clear(spans[rows], corners)
         na = len(ka)
         # second kind: neither side
         out[np.isin(k, kb[lone[na:]])] = _NEITHER
