@@ -189,7 +189,7 @@ class CollinearityEvents:
         if self.lazy_samples and self.strips is None:
             k = np.flatnonzero(keep)
             side[k] = self._wedge_sides(
-                k, len(ta), xa, la, w, s_, vx, spans, pb, lb, cvx, i, j, ii, kk
+                k, len(ta), xa, la, w, s_, vx, spans, fix, pb, lb, cvx, ii, kk
             )
         kept = np.flatnonzero(keep)
         kept = kept[np.argsort(t[kept], kind="stable")]
@@ -205,71 +205,89 @@ class CollinearityEvents:
         return ts[first], out, sides
 
     def _wedge_sides(
-        self, k, n_a, xa, la, w, s_, vx, spans, pb, lb, cvx, i, j, ii, kk
+        self, k, n_a, xa, la, w, s_, vx, spans, fix, pb, lb, cvx, ii, kk
     ) -> np.ndarray:
         """The side codes (see ``_SIDES``) of the events ``k`` (indices into :meth:`_events`'
-        arrays: the first ``n_a`` of the first kind, a moving anchor on a line of two corners
-        or of an obstacle edge; the rest of the second kind, the line of two target vertices
-        through a corner; ``spans``: the segment spanning each event's three anchors; the
-        other arguments as there), with the whole outline wanted.
+        arrays: the first ``n_a`` of the first kind, a target vertex x on the line of two
+        corners or of an obstacle edge, ``fix[la]`` its two environment vertices; the rest of
+        the second kind, the line of two target vertices through a corner; ``spans``: the
+        segment spanning each event's three anchors; the other arguments as there), with
+        the whole outline wanted.
 
-        Where the event's corners are *lone* (each has both its edges strictly off the
-        line, and no other obstacle edge comes within ``1e-6`` of the scene's size of the
-        segment spanning the three anchors), a sight line close to the line is blocked
-        near the event only at a corner it passes on that corner's obstacle side, and
-        reaches the target otherwise.  A point p in the wedge the event opens (beyond the
-        corner farthest from the target, between the two lines through it) has two such
-        sight lines, to the two anchors on the target's side, passing that corner on
-        opposite sides:
+        Where the event is *lone* (no obstacle edge but the corners' own comes within
+        ``1e-6`` of the scene's size of its span, and the corners' edges off the line lie
+        strictly on one side of it: both edges of a corner of two, the other edge at each
+        end of an obstacle edge), a sight line close to the line is blocked near the event
+        only where it passes a corner (or crosses the obstacle edge) on the obstacle's side,
+        and reaches the target otherwise.  A point p in the wedge the event opens (beyond the
+        corner farthest from the target, between the two lines through it) has two sight
+        lines along them, to the two anchors on the target's side, passing that corner on
+        opposite sides; and sight lines to the points of the target just beside x, on the
+        target's side of the line (x's edges lie strictly on one side), pass the corners on
+        that side:
 
-        * second kind (target vertices a_n, a_f through corner b): one of them passes b on
-          its free side and reaches the target, so p is not blind and no shadow opens:
+        * second kind (target vertices a_n, a_f through corner b): one of the two passes b
+          on its free side and reaches the target, so p is not blind and no shadow opens:
           neither side;
-        * first kind (target vertex x, corners b_n nearer x and b_f), corners of obstacles
-          on opposite sides of the line: the sight line to x passes b_n and b_f on opposite
-          sides, so it is blocked only while it passes b_n on its obstacle's side, i.e.
-          while x is on that side of the line: the side of the event where x is;
-        * otherwise (the line of an obstacle edge, both obstacles on one side, corners not
-          lone): either side."""
+        * first kind, obstacles on the side opposite the target (both corners, or the
+          obstacle edge): the sight lines beside x pass on the free side: neither side;
+        * first kind, corners (not the two ends of one obstacle edge) of obstacles on
+          opposite sides of the line: the sight line to
+          x passes b_n (the corner nearer x) and b_f on opposite sides, so it is blocked
+          only while it passes b_n on its obstacle's side, i.e. while x is on that side of
+          the line: the side of the event where x is;
+        * otherwise (obstacles and the target on one side, not lone): either side."""
         out = np.zeros(len(k), dtype=int)
         ka, kb = k[k < n_a], k[k >= n_a]
-        ka = ka[(la[ka] < len(i)) & (xa[ka] < self.m)]  # two corners, a target vertex
+        ka = ka[(xa[ka] < self.m) & (fix[la[ka]] >= 0).all(axis=1)]
         if len(ka) + len(kb) == 0:
             return out
-        pair = la[ka]
-        corners = np.concatenate(
-            [
-                np.stack([cvx[i[pair]], cvx[j[pair]]], axis=1),
-                np.stack([cvx[lb[kb - n_a]], cvx[lb[kb - n_a]]], axis=1),
-            ]
-        )
+        corners = np.concatenate([fix[la[ka]], np.repeat(cvx[lb[kb - n_a], None], 2, axis=1)])
         p, q = pb[kb - n_a], self.ring0
-        lines = np.concatenate([w[pair], q[kk[p]] - q[ii[p]]])
+        lines = np.concatenate([w[la[ka]], q[kk[p]] - q[ii[p]]])
         rows = np.concatenate([ka, kb])
-        s0 = self._obstacle_side(corners[:, 0], lines)
-        s1 = self._obstacle_side(corners[:, 1], lines)
+        s0 = self._obstacle_side(corners[:, 0], corners[:, 1], lines)
+        s1 = self._obstacle_side(corners[:, 1], corners[:, 0], lines)
         lone = (s0 != 0) & (s1 != 0) & self._clear(spans[rows], corners)
         na = len(ka)
-        # second kind: neither side
-        out[np.isin(k, kb[lone[na:]])] = _NEITHER
-        # first kind: obstacles on opposite sides; x on the near corner's side after it
-        sel = lone[:na] & (s0[:na] == -s1[:na])
+        out[np.isin(k, kb[lone[na:]])] = _NEITHER  # second kind
+        lone, s0, s1, lines = lone[:na], s0[:na], s1[:na], lines[:na]
+        # the target's side at x: its two edges strictly on one side of the line
+        x = xa[ka]
+        m = self.m
+        tp = _side(lines, q[(x - 1) % m] - q[x])
+        tn = _side(lines, q[(x + 1) % m] - q[x])
+        s_t = np.where(tp == tn, tp, 0)
+        code = np.zeros(na, dtype=int)
+        code[lone & (s0 == s1) & (s_t == -s0)] = _NEITHER
+        # (corners of two obstacles, or not neighbours: a sight line crossing the line
+        # between the two ends of an obstacle edge crosses the edge)
+        env = self.env
+        c0, c1 = corners[:na, 0], corners[:na, 1]
+        edge = (env.vert_next[c0] == env.vert[c1]).all(axis=1) | (
+            env.vert_prev[c0] == env.vert[c1]
+        ).all(axis=1)
+        sel = lone & (s0 == -s1) & ~edge
         if sel.any():
             ks = ka[sel]
             near_i = np.abs(s_[ks, 0] - s_[ks, 2]) <= np.abs(s_[ks, 1] - s_[ks, 2])
-            s_near = np.where(near_i, s0[:na][sel], s1[:na][sel])
-            after = _side(lines[:na][sel], vx[xa[ks]])
-            code = np.where(after == 0, 0, np.where(after == s_near, 1, -1))
-            out[np.searchsorted(k, ks)] = code
+            s_near = np.where(near_i, s0[sel], s1[sel])
+            after = _side(lines[sel], vx[xa[ks]])
+            code[sel] = np.where(after == 0, 0, np.where(after == s_near, 1, -1))
+        out[np.searchsorted(k, ka)] = code
         return out
 
-    def _obstacle_side(self, v: np.ndarray, w: np.ndarray) -> np.ndarray:
-        """Per row: the side (1 left, -1 right) of the line of direction ``w`` through the
-        environment vertex ``v`` where both its edges lie, 0 where one lies on the line
-        (:func:`_side`) or they lie on both sides."""
+    def _obstacle_side(self, v: np.ndarray, other: np.ndarray, w: np.ndarray) -> np.ndarray:
+        """Per row: the side (1 left, -1 right, :func:`_side`) of the line of direction ``w``
+        through the environment vertex ``v`` where its edges lie, but an edge to ``other``
+        (the line's other vertex: the line of an obstacle edge); 0 where one lies on the
+        line or they lie on both sides."""
         env = self.env
         sp = _side(w, env.vert_prev[v] - env.vert[v])
         sn = _side(w, env.vert_next[v] - env.vert[v])
+        to = env.vert[other]
+        sp = np.where((env.vert_prev[v] == to).all(axis=1), sn, sp)
+        sn = np.where((env.vert_next[v] == to).all(axis=1), sp, sn)
         return np.where(sp == sn, sp, 0)
 
     def _clear(self, segs: np.ndarray, corners: np.ndarray) -> np.ndarray:

@@ -431,9 +431,10 @@ def test_events_sample_only_the_sides_where_their_wedge_is_blind(name, monkeypat
     near its line, no edge along it) samples only the sides where its wedge can be a shadow
     (:meth:`geometry._sweep.events.CollinearityEvents._wedge_sides`).  Checked from the
     positions 1e-4 of the sweep away from each such event: a point of the wedge on a side not
-    sampled sees the target (its sight line to the moving vertex, or to one of the two
-    target vertices, is free), and on the one side a first-kind event samples it is blind to
-    the moving vertex (the rule's sign); the regions are those with both sides sampled
+    sampled sees the target (its sight line to the moving vertex, to a point of the target
+    beside it, or to one of the two target vertices, is free), and on the one side a
+    first-kind event samples it is blind to the moving vertex (the rule's sign); the regions
+    are those with both sides sampled
     (within the tolerance of :func:`_assert_close`), with fewer samples on
     ``willow_north``."""
     ev = S.Sweeper._events
@@ -460,6 +461,11 @@ def test_events_sample_only_the_sides_where_their_wedge_is_blind(name, monkeypat
                 near, far = sorted((c1, c2), key=lambda c: float(np.hypot(*(c - x))))
                 u = [(c - x) / np.hypot(*(c - x)) for c in (near, far)]
                 ends, beyond, span = (x,), far, float(np.hypot(*(far - near)))
+                if not sides:  # and a point of the target beside x (into its corner)
+                    ring, k = sw.ring0 + q, mov[0] - sw.n_fixed
+                    nb = [ring[(k + d) % sw.m] - x for d in (-1, 1)]
+                    into = sum(v / np.hypot(*v) for v in nb)
+                    ends = (x, x + 0.01 * span * into / np.hypot(*into))
             else:  # the line of two target vertices through corner b: the wedge beyond b
                 a1, a2, b = pos
                 u = [(b - a) / np.hypot(*(b - a)) for a in (a1, a2)]
