@@ -183,13 +183,12 @@ class CollinearityEvents:
         ids += [
             ((n + int(ii[p]), n + int(kk[p])), (int(cvx[k]),)) for p, k in zip(pb, lb, strict=True)
         ]
-        # the sides of each event where its wedge can be a shadow (the previous rules, and
-        # the 5.2 sweeps, whose wanted pieces these arguments do not cover: either side)
+        # the sides of each event where its wedge can be a shadow (the previous rules: either)
         side = np.zeros(len(t), dtype=int)
-        if self.lazy_samples and self.strips is None:
+        if self.lazy_samples:
             k = np.flatnonzero(keep)
             side[k] = self._wedge_sides(
-                k, len(ta), xa, la, w, s_, vx, spans, fix, pb, lb, cvx, ii, kk
+                k, len(ta), xa, la, w, s_, vx, spans, fix, pb, lb, cvx, ii, kk, q0 + t[:, None] * dq
             )
         kept = np.flatnonzero(keep)
         kept = kept[np.argsort(t[kept], kind="stable")]
@@ -205,14 +204,17 @@ class CollinearityEvents:
         return ts[first], out, sides
 
     def _wedge_sides(
-        self, k, n_a, xa, la, w, s_, vx, spans, fix, pb, lb, cvx, ii, kk
+        self, k, n_a, xa, la, w, s_, vx, spans, fix, pb, lb, cvx, ii, kk, qe
     ) -> np.ndarray:
         """The side codes (see ``_SIDES``) of the events ``k`` (indices into :meth:`_events`'
         arrays: the first ``n_a`` of the first kind, a target vertex x on the line of two
         corners or of an obstacle edge, ``fix[la]`` its two environment vertices; the rest of
         the second kind, the line of two target vertices through a corner; ``spans``: the
-        segment spanning each event's three anchors; the other arguments as there), with
-        the whole outline wanted.
+        segment spanning each event's three anchors; the other arguments as there; ``qe``:
+        the target's reference point at each event).  With part of the outline wanted (5.2)
+        only where the target's anchors are wanted with all of the outline near them, and
+        for the second kind the target edge between them (:meth:`_wanted_near`): what p sees
+        there is wanted.
 
         Where the event is *lone* (no obstacle edge but the corners' own comes within
         ``1e-6`` of the scene's size of its span, and the corners' edges off the line lie
@@ -250,6 +252,14 @@ class CollinearityEvents:
         s1 = self._obstacle_side(corners[:, 1], corners[:, 0], lines)
         lone = (s0 != 0) & (s1 != 0) & self._clear(spans[rows], corners)
         na = len(ka)
+        if self.strips is not None:  # 5.2: the target's anchors and what lies between wanted
+            v0 = np.concatenate([xa[ka], ii[p]])
+            v1 = np.concatenate([xa[ka], kk[p]])
+            lone &= self._wanted_near(v0, qe[rows]) & self._wanted_near(v1, qe[rows])
+            m = self.m
+            e = np.where(kk[p] == ii[p] + 1, ii[p], m - 1)
+            joined = (kk[p] == ii[p] + 1) | ((ii[p] == 0) & (kk[p] == m - 1))
+            lone[na:] &= joined & self._wanted_near(e, qe[kb], edge=True)
         out[np.isin(k, kb[lone[na:]])] = _NEITHER  # second kind
         lone, s0, s1, lines = lone[:na], s0[:na], s1[:na], lines[:na]
         # the target's side at x: its two edges strictly on one side of the line
@@ -276,6 +286,29 @@ class CollinearityEvents:
             code[sel] = np.where(after == 0, 0, np.where(after == s_near, 1, -1))
         out[np.searchsorted(k, ka)] = code
         return out
+
+    def _wanted_near(self, v: np.ndarray, q: np.ndarray, edge: bool = False) -> np.ndarray:
+        """Per row, with the target at reference point ``q[r]``: is every point of its
+        outline within ``1e-6`` of the scene's size of vertex ``v[r]`` wanted (no strip of
+        its two edges comes that near), or with ``edge``, every point of edge ``v[r]``?"""
+        arr = getattr(self, "_strip_arr", None)
+        if arr is None:
+            arr = self._strip_arr = np.array(
+                [None if u is None or u.is_empty else u for u in self.strips] + [None],
+                dtype=object,
+            )[:-1]
+        m, r0 = self.m, self.ring0
+        if edge:
+            geom = shapely.linestrings(np.stack([r0[v] + q, r0[(v + 1) % m] + q], axis=1))
+            near = [v]
+        else:
+            geom = shapely.points(r0[v] + q)
+            near = [(v - 1) % m, v]
+        ok = np.ones(len(v), dtype=bool)
+        for i in near:
+            d = shapely.distance(arr[i], geom)
+            ok &= ~(d <= 1e-6 * self.env.scale)  # NaN: no strip, the whole edge wanted
+        return ok
 
     def _obstacle_side(self, v: np.ndarray, other: np.ndarray, w: np.ndarray) -> np.ndarray:
         """Per row: the side (1 left, -1 right, :func:`_side`) of the line of direction ``w``
