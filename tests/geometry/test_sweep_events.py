@@ -427,16 +427,17 @@ def _sees(sw, p: np.ndarray, a: np.ndarray) -> bool:
 
 @pytest.mark.parametrize("name", ["real/willow_north", "lab", "fuzz:200326", "real/willow_south"])
 def test_events_sample_only_the_sides_where_their_wedge_is_blind(name, monkeypatch) -> None:
-    """With the whole outline wanted, an event whose corners are lone (no other obstacle edge
-    near its line, no edge along it) samples only the sides where its wedge can be a shadow
+    """An event whose corners are lone (no other obstacle edge near its line, no edge along
+    it) samples only the sides where its wedge can be a shadow
     (:meth:`geometry._sweep.events.CollinearityEvents._wedge_sides`).  Checked from the
     positions 1e-4 of the sweep away from each such event: a point of the wedge on a side not
     sampled sees the target (its sight line to the moving vertex, to a point of the target
     beside it, or to one of the two target vertices, is free), and on the one side a
-    first-kind event samples it is blind to the moving vertex (the rule's sign); the regions
-    are those with both sides sampled
-    (within the tolerance of :func:`_assert_close`), with fewer samples on
-    ``willow_north``."""
+    first-kind event samples it is blind to the moving vertex (the rule's sign); in the 5.2
+    sweeps (part of the outline wanted), the outline at the event (:meth:`Sweeper.outline`)
+    is wanted on both edges at each target anchor and between two of them; the regions
+    (swept and 5.2) are those with both sides sampled (within the tolerance of
+    :func:`_assert_close`), with fewer samples on ``willow_north``."""
     ev = S.Sweeper._events
     seen: list[tuple] = []
 
@@ -453,6 +454,16 @@ def test_events_sample_only_the_sides_where_their_wedge_is_blind(name, monkeypat
     for sw, q0, dq, t, (mov, other), sides in seen:
         if sides == (-1, 1):
             continue
+        if sw.strips is not None:  # what the wedge's sight lines reach is wanted
+            _, wanted, ids = sw.outline(q0 + t * dq)
+            at = [int(np.flatnonzero(ids == a)[0]) for a in mov]
+            n = len(ids)
+            near = {e for a in at for e in ((a - 1) % n, a)}
+            if len(mov) == 2:  # and the outline between the two vertices
+                lo, hi = sorted(at)
+                near |= set(range(lo, hi)) if hi - lo < n - hi + lo else set(range(hi, lo + n))
+            assert all(wanted[e % n] for e in near), (name, t, mov, other)
+            checked += 1
         for sign in (-1, 1):
             q = q0 + (t + sign * 1e-4) * dq
             pos = sw.pos(np.array([*mov, *other]), np.repeat(q[None], 3, axis=0))
