@@ -78,10 +78,8 @@ class CollinearityEvents:
         there).  Also, per time, the anchor ids of its
         events: ``(moving ids, other ids)`` each (ids as :meth:`pos` takes them; -1: the
         neighbour of an obstacle corner not known), and per event the sides of it (-1 before,
-        1 after) where its wedge can be a shadow (:meth:`_wedge_side`; with the whole outline
-        wanted, none for a line of two target vertices crossing a corner: of a point in the
-        wedge, the sight lines to the two vertices pass the corner on opposite sides, and
-        the one on the free side reaches the target), for :meth:`_live_mids`.
+        1 after) where its wedge can be a shadow (:meth:`_wedge_sides`; with the previous
+        rules both), for :meth:`_live_mids`.
 
         At such an event two shadow-edge lines coincide, and a shadow can be born as a
         segment on that line (it then grows from a line that continues an edge of an
@@ -295,7 +293,7 @@ class CollinearityEvents:
         outline within ``1e-6`` of the scene's size of vertex ``v[r]`` wanted (no strip of
         its two edges comes that near), or with ``edge``, every point of edge ``v[r]``?"""
         arr = getattr(self, "_strip_arr", None)
-        if arr is None:
+        if arr is None:  # one object per edge (the trailing None keeps numpy from nesting)
             arr = self._strip_arr = np.array(
                 [None if u is None or u.is_empty else u for u in self.strips] + [None],
                 dtype=object,
