@@ -38,6 +38,8 @@ class BirthChecks:
         target's shadows, which the 5.2 shadows contain, so a shadow of the full target born in
         between is caught here too (and the 5.2 region stays inside R(G); fuzz seed 411063, mixed
         G/H). Births of shadows that exist only because pieces are unwanted are not detected by it.
+        An alarm whose bisection would find nothing (the halves' eroded targets settle it,
+        :meth:`_settled`; lazy rules) takes no sample.
         ``first``: :meth:`_birth_bounds` of the first level when the caller has it."""
         todo = [
             (r, a, b, 0)
@@ -53,7 +55,7 @@ class BirthChecks:
             pairs, split = first if first is not None else self._birth_bounds(level)
             first = None
             self._prefetch([], pairs + [p for ps in split.values() for p in ps])
-            todo, mids = [], []
+            todo, mids, alarms, new_at = [], [], [], []
             for i, (r, a, b, depth) in enumerate(level):
                 self._check_time()
                 if i in split:
@@ -64,14 +66,66 @@ class BirthChecks:
                     # no eroded target: bisect where one exists within the depth limit
                     new = self._core_within_depth(b - a, depth, r.dq)
                 else:
-                    new = len(self._born(upper, r.frame(a)[0], r.frame(b)[0])) > 0
+                    born = self._born(upper, r.frame(a)[0], r.frame(b)[0])
+                    new = len(born) > 0
+                    if new and i not in split and self._halves_checked(r, a, b, depth):
+                        alarms.append((i, born))  # decided below, in one batch
                 if new:
                     mids.append((r, a, 0.5 * (a + b), b, depth))
+                    new_at.append(i)
+            if alarms:
+                # an alarm whose bisection would find nothing takes no sample (_settled); the
+                # halves' eroded targets of all alarms of the level in one batch
+                halves = {i: self._halves(*level[i][:3]) for i, _ in alarms}
+                self._prefetch([], [p for h in halves.values() for p in h])
+                left = {i for i, born in alarms if self._settled(*level[i][:3], born, halves[i])}
+                mids = [m for i, m in zip(new_at, mids, strict=True) if i not in left]
             self._prefetch([r.q0 + m * r.dq for r, _, m, _, _ in mids])
             for r, a, m, b, depth in mids:
                 r.frame(m)
                 r.stats["refined"] += 1
                 todo += [(r, a, m, depth + 1), (r, m, b, depth + 1)]
+
+    def _halves(self, r, a: float, b: float) -> list[tuple[np.ndarray, np.ndarray]]:
+        """The two halves ``(qa, qm), (qm, qb)`` of the interval ``[a, b]`` of the run ``r``."""
+        qa, qm, qb = (r.q0 + t * r.dq for t in (a, 0.5 * (a + b), b))
+        return [(qa, qm), (qm, qb)]
+
+    def _halves_checked(self, r, a: float, b: float, depth: int) -> bool:
+        """Whether the bisection of an alarmed interval ``[a, b]`` at ``depth`` would check
+        its halves against their eroded targets' shadows (the next level exists and each
+        half has an eroded target): then :meth:`_settled` can tell ahead what it would find
+        (lazy rules only)."""
+        if not self.lazy_samples or depth + 1 >= self.max_depth:
+            return False
+        return all(self._eroded_core(qa, qb) is not None for qa, qb in self._halves(r, a, b))
+
+    def _settled(self, r, a: float, b: float, born: np.ndarray, halves: list) -> bool:
+        """Whether the sample that an alarm on ``[a, b]`` (``born``: the parts of the eroded
+        target's shadow apart from both ends' shadows, :meth:`_born`) asks for at the
+        midpoint m can be left out: the bisection would find nothing with it.
+
+        With the sample, the next level checks each half against the eroded target of that
+        half, U1 on [a, m] and U2 on [m, b] (both exist: :meth:`_halves_checked`), and asks for
+        no more where every part of U1 meets S_a and every part of U2 meets S_b (meeting S_m
+        too is not needed then).  The sample itself, S_m, lies inside U1 n U2; where that
+        has no part in ``born`` (none wider than the union's grid, as :meth:`_born` counts),
+        S_m holds nothing of the alarm, so the bisection that the alarm starts would take
+        the one sample and find nothing in it or below it.  Then it is not taken; otherwise
+        it is, as before, and the next level reuses the halves' eroded targets computed
+        here.  ``born`` lies in the free space, so its part outside U1 n U2 is ``born - X1 -
+        X2`` (X: what an eroded target's shadow does not hold, :meth:`_eroded_seen`)."""
+        sa, sb = r.frame(a)[0], r.frame(b)[0]
+        (qa, qm), (_, qb) = halves
+        u1, u2 = self._eroded_shadow(qa, qm), self._eroded_shadow(qm, qb)
+        if len(self._born(u1, sa, sa)) or len(self._born(u2, sb, sb)):
+            return False
+        g = self.shadow_grid
+        left = union_all(list(born), grid_size=g)
+        for qx, qy in halves:
+            left = areal(snapped(shapely.difference, left, self._eroded_seen(qx, qy), g))
+        parts = shapely.get_parts(left)
+        return not (2.0 * shapely.area(parts) > self.grid * shapely.length(parts)).any()
 
     def _birth_bounds(self, level: list[tuple]) -> tuple[list, dict[int, list]]:
         """For the intervals ``level`` ((run, a, b, depth) each) of the birth check: their
@@ -127,26 +181,38 @@ class BirthChecks:
     def _eroded_shadow(self, qa: np.ndarray, qb: np.ndarray) -> shapely.Geometry | None:
         """Shadow of the part of A common to all A_q, q in [qa, qb] (it contains
         every S(q) there); None when that part is empty."""
-        seen = self._eroded_seen(qa, qb)
-        if seen is None:
-            return None
-        return polygonal(snapped(shapely.difference, self.free, seen, self.shadow_grid))
+        key = (tuple(qa.tolist()), tuple(qb.tolist()))
+        cache = self.__dict__.setdefault("_eroded_shadows", {})
+        if key not in cache:
+            seen = self._eroded_seen(qa, qb)
+            cache[key] = (
+                None
+                if seen is None
+                else polygonal(snapped(shapely.difference, self.free, seen, self.shadow_grid))
+            )
+        return cache[key]
 
     def _eroded_seen(self, qa: np.ndarray, qb: np.ndarray) -> shapely.Geometry | None:
         """The placements that see the part of A common to all A_q, q in [qa, qb], or lie in
         it (that part and its weak visibility region, snap-rounded); None when it is empty."""
+        key = (tuple(qa.tolist()), tuple(qb.tolist()))
+        cache = self.__dict__.setdefault("_eroded_xs", {})
+        if key in cache:
+            return cache[key]
         got = self._eroded_core(qa, qb)
         if got is None:
+            cache[key] = None
             return None
         core, ring = got
-        reg = self._eroded_pre.pop((tuple(qa.tolist()), tuple(qb.tolist())), None)
+        reg = self._eroded_pre.pop(key, None)
         if reg is None:
             reg = weak_visibility(
                 self.env, ring, np.ones(len(ring), dtype=bool), self.eps_aim, self._anchors()
             )
         g = self.shadow_grid  # as in shadow(): the region's hole nearly coincides with core
         # snap-rounding can raise "Ring edge missing" at scale 1e-3 (fuzz seed 201039, --swept)
-        return areal(snapped(shapely.union, reg, core, g))
+        cache[key] = areal(snapped(shapely.union, reg, core, g))
+        return cache[key]
 
     def _split_shadow(self, pieces: list[tuple[np.ndarray, np.ndarray]]) -> shapely.Geometry:
         """The union of the eroded targets' shadows (:meth:`_eroded_shadow`) of the

@@ -83,7 +83,7 @@ class StationaryShadows:
         todo_e = []
         for qa, qb in eroded:
             key = (tuple(qa.tolist()), tuple(qb.tolist()))
-            if key in self._eroded_pre or key in keys:
+            if key in self._eroded_pre or key in keys or key in self.__dict__.get("_eroded_xs", {}):
                 continue
             keys.add(key)
             got = self._eroded_core(qa, qb)

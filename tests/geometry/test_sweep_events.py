@@ -508,3 +508,92 @@ def test_events_sample_only_the_sides_where_their_wedge_is_blind(name, monkeypat
         ref, made_ref = _run(name, monkeypatch, lazy=True)
     assert orig is E.CollinearityEvents._wedge_sides
     _assert_close_with_fewer_samples(name, (got, made), (ref, made_ref))
+
+
+@pytest.mark.parametrize("name", ["real/willow_north", "fuzz:200075", "fuzz:200058", "fuzz:200071"])
+def test_a_birth_alarm_whose_bisection_would_find_nothing_takes_no_sample(
+    name, monkeypatch
+) -> None:
+    """An interval whose eroded target's shadow has a part apart from both ends' shadows (an
+    alarm) is bisected with a sample at its midpoint m, unless its halves' eroded targets
+    settle it (:meth:`geometry._sweep.births.BirthChecks._settled`): each half's parts meet
+    that half's end shadow, and U1 n U2 (which holds S_m) has nothing in the alarm.  Checked:
+    some alarm is settled (not vacuous); the shadow at each settled midpoint, computed afresh,
+    lies in the sweep's union but for slivers narrower than its grid (the sample would have
+    added nothing); with the rule off (every alarm sampled, as before) there are more samples,
+    and every placement of the region that the rule adds (vertices and interior points of the
+    difference) is seen at configurations densely spaced on the boundary of G (the exact
+    point test of the sweep), so the rule drops no shadow."""
+    from geometry._sweep import births as B
+
+    settled: list[tuple] = []
+    unions: dict[int, shapely.Geometry] = {}
+    orig_settled, orig_union = B.BirthChecks._settled, S._union_pieces
+
+    def spy(self, r, a, b, born, halves):
+        got = orig_settled(self, r, a, b, born, halves)
+        if got:
+            settled.append((self, r.q0 + 0.5 * (a + b) * r.dq))
+        return got
+
+    def union(sw, pieces):
+        unions[id(sw)] = got = orig_union(sw, pieces)
+        return got
+
+    kw = {"theta": 0.0, "timeout": None, "conservative": True}
+
+    def query():
+        return partial_region(_scene(name), target_in="goal", **kw)
+
+    with monkeypatch.context() as m:
+        m.setattr(B.BirthChecks, "_settled", spy)
+        m.setattr(S, "_union_pieces", union)
+        got, made = _with_rule(True, query, monkeypatch)
+    assert settled  # not vacuous
+    for sw, qm in settled:
+        rest = shapely.get_parts(shapely.difference(sw.shadow(qm)[0], unions[id(sw)]))
+        assert not (2.0 * shapely.area(rest) > sw.grid * shapely.length(rest)).any(), name
+    with monkeypatch.context() as m:
+        m.setattr(B.BirthChecks, "_halves_checked", lambda self, *a: False)
+        ref, made_ref = _with_rule(True, query, monkeypatch)
+    assert sum(len(sw._frames) for sw in made) < sum(len(sw._frames) for sw in made_ref)
+    added = shapely.difference(got, ref)
+    pts = shapely.get_coordinates(added)
+    if len(pts):  # the vertices and random interior points of the region added
+        rng = np.random.default_rng(0)
+        x0, y0, x1, y1 = added.bounds
+        inner = np.column_stack([rng.uniform(x0, x1, 2000), rng.uniform(y0, y1, 2000)])
+        pts = np.vstack([pts, inner[shapely.contains_xy(added, inner[:, 0], inner[:, 1])]])
+        sw, scene = made[0], _scene(name)
+        # the sweeper's frame: reference point moved into the target's kernel
+        c = S.star_center(ccw_ring(scene.target_at(0.0, 0.0, 0.0)))
+        ring = np.asarray(scene.goal_geom.exterior.coords)[:, :2] + c
+        for a, b in zip(ring[:-1], ring[1:], strict=True):
+            for t in np.linspace(0.0, 1.0, 301):
+                q = np.repeat((a + t * (b - a))[None], len(pts), axis=0)
+                assert not sw.blind(pts, q).any(), (name, a + t * (b - a))
+
+
+def test_an_alarm_is_settled_only_where_both_halves_see_it_and_each_meets_its_end() -> None:
+    """:meth:`geometry._sweep.births.BirthChecks._settled` on ``lab``, a square moving 0.2
+    (each half has an eroded target): an alarm where both halves' eroded targets are seen
+    (nothing of U1 n U2 there) is settled; one behind an obstacle, in the shadow of both
+    halves (where the midpoint's shadow S_m is), is not; nor is the first one once the ends'
+    shadows are empty (the halves' parts then meet no end shadow)."""
+    scene = Scene.load("sensorplan_gym/scenes/lab.json")
+    ring = np.array([[-0.1, -0.1], [0.1, -0.1], [0.1, 0.1], [-0.1, 0.1]])
+    q0, q1 = np.array([2.0, 3.0]), np.array([2.2, 3.0])
+    hull = shapely.convex_hull(shapely.multipoints(np.vstack([ring + q0, ring + q1])))
+    hull = np.asarray(shapely.orient_polygons(hull).exterior.coords)[:-1]
+    sw = S.Sweeper(scene_domain(scene), scene.free_space, ring, hull, None, 0.0, 1e-3)
+    run = S._Run(sw, q0, q1)
+    assert sw._halves_checked(run, 0.0, 1.0, 0)
+    halves = sw._halves(run, 0.0, 1.0)
+    seen = shapely.box(2.05, 3.4, 2.15, 3.45)  # just above the target
+    hidden = shapely.box(2.0, 6.0, 2.1, 6.05)  # behind the obstacle [1, 3] x [4, 5]
+    assert shapely.covers(scene.free_space, seen) and shapely.covers(scene.free_space, hidden)
+    assert shapely.covers(sw.shadow(q0 + 0.5 * (q1 - q0))[0], hidden)
+    assert sw._settled(run, 0.0, 1.0, np.array([seen]), halves)
+    assert not sw._settled(run, 0.0, 1.0, np.array([hidden]), halves)
+    run.frames[0.0] = run.frames[1.0] = (shapely.Polygon(), [])
+    assert not sw._settled(run, 0.0, 1.0, np.array([seen]), halves)
