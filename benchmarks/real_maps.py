@@ -9,7 +9,8 @@ For every scene of ``sensorplan_gym/scenes/real/`` (written by
 :mod:`benchmarks.make_real_maps` from the Willow Garage and LSE arena occupancy maps, and by
 :mod:`benchmarks.make_geojson_maps` from an OpenStreetMap indoor map in GeoJSON; G and H are
 regular pentagons) it times, each call on a freshly loaded Scene (so every call
-builds its per-scene structures), median over ``--reps`` calls after one warm-up call:
+builds its per-scene structures), median over ``--reps`` calls after one warm-up call, the
+queries of a scene interleaved rep by rep (a slow spell of the machine falls on all alike):
 
 * ``complete_region`` and ``partial_region`` of the stationary target at G's
   representative point, orientation 0;
@@ -91,17 +92,22 @@ def _repro(name: str) -> tuple[dict, float]:
     return d["scene"], theta
 
 
-def _time_fresh(fn: Callable[[Scene], Any], load: Callable[[], Scene], reps: int) -> tuple:
-    """Median seconds of ``fn`` on a freshly loaded scene (``reps`` calls after a warm-up)
-    and the area of its answer."""
-    area = fn(load()).area
-    times = []
+def _time_fresh(
+    fns: list[Callable[[Scene], Any]], load: Callable[[], Scene], reps: int
+) -> list[tuple[float, float]]:
+    """Per function of ``fns``: its median seconds on a freshly loaded scene (``reps`` calls
+    after a warm-up) and the area of its answer.  The calls are interleaved, rep by rep (each
+    function once per rep, in order), so that a slow spell of a noisy machine falls on every
+    query of the scene alike instead of on one (a row's ratios come from these medians)."""
+    areas = [float(fn(load()).area) for fn in fns]
+    times: list[list[float]] = [[] for _ in fns]
     for _ in range(reps):
-        s = load()
-        t0 = time.perf_counter()
-        fn(s)
-        times.append(time.perf_counter() - t0)
-    return statistics.median(times), float(area)
+        for fn, got in zip(fns, times, strict=True):
+            s = load()
+            t0 = time.perf_counter()
+            fn(s)
+            got.append(time.perf_counter() - t0)
+    return [(statistics.median(t), a) for t, a in zip(times, areas, strict=True)]
 
 
 def _cases() -> list[tuple[str, str, Callable[[], Scene], float]]:
@@ -138,8 +144,8 @@ def run(reps: int, slow: bool = True) -> dict[str, Any]:
             "query_s": {},
             "area_m2": {},
         }
-        for qname, fn in queries(theta):
-            t, a = _time_fresh(fn, load, reps)
+        qs = queries(theta)
+        for (qname, _), (t, a) in zip(qs, _time_fresh([f for _, f in qs], load, reps), strict=True):
             row["query_s"][qname] = t
             row["area_m2"][qname] = a
             print(f"  {name:>14} edges={edges:4d} {qname:24s} {1e3 * t:9.1f} ms  {a:8.2f} m2")
@@ -176,7 +182,8 @@ def render(data: dict[str, Any]) -> str:
     lines += [
         "",
         f"`{data['command']}`: median of {data['reps']} calls, each on a freshly loaded scene "
-        "(after one warm-up call); G and H regular pentagons on the real maps; "
+        "(after one warm-up call; the queries of a scene interleaved, one call of each per "
+        "rep); G and H regular pentagons on the real maps; "
         "anchor = median CGAL visibility polygon (pyvispoly) at 20 free points of the same "
         "scene, same run; "
         '"swept, previous rules": the swept query sampled as before issue 25\'s lazy rules '

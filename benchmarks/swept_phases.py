@@ -8,7 +8,8 @@ swept partial query over G (paper 3.2.2-3.2.3, ``partial_region(target_in="goal"
 into the phases of :func:`geometry.sweep.swept_shadows` as its :class:`~geometry.sweep.PhaseClock`
 reports them (median over ``--reps`` calls, each on a freshly loaded scene, after one
 warm-up call), each as a multiple of the stationary partial query on the same scene measured
-in the same run (the anchor), with the exact stationary shadows ("samples") each phase took:
+in the same run, its calls interleaved with the swept ones (the anchor), with the exact
+stationary shadows ("samples") each phase took:
 
 * *K's corners*: the one weak visibility region of K = CH(A + G) that tells which obstacle
   corners can graze a beam into the target;
@@ -76,14 +77,13 @@ def run(reps: int, slow: bool = True) -> dict[str, Any]:
         s = load()
         edges = len(s.bounds) + sum(len(o) for o in s.obstacles)
         partial_region(s, target_at=_pose(s, theta))
-        stationary = []
-        for _ in range(reps):
-            s = load()
-            t0 = time.perf_counter()
-            partial_region(s, target_at=_pose(s, theta))
-            stationary.append(time.perf_counter() - t0)
-        runs = []
-        for k in range(reps + 1):  # the first call warms up
+        stationary, runs = [], []
+        for k in range(reps + 1):  # the first call warms up; the two queries interleaved
+            if k:
+                s = load()
+                t0 = time.perf_counter()
+                partial_region(s, target_at=_pose(s, theta))
+                stationary.append(time.perf_counter() - t0)
             s = load()
             sink: dict[str, Any] = {}
             t0 = time.perf_counter()
@@ -201,10 +201,10 @@ def render(data: dict[str, Any]) -> str:
         "",
         f"`{data['command']}`: medians of {data['reps']} calls, each on a freshly loaded scene "
         "(after one warm-up call), each phase as a multiple of the stationary partial query on "
-        "the same scene in the same run (its median in the third column; the phases' medians "
-        "need not add up to the query's); in parentheses the exact "
-        "stationary shadows (samples) the phase took; *rest*: the query's own work around the "
-        "sweep (the scene's domain, the final difference); *without event samples*: the whole "
+        "the same scene in the same run, interleaved with the swept calls (its median in the "
+        "third column; the phases' medians need not add up to the query's); in parentheses the "
+        "exact stationary shadows (samples) the phase took; *rest*: the query's own work around "
+        "the sweep (the scene's domain, the final difference); *without event samples*: the whole "
         "swept query with the samples next to the collinearity events switched off (a "
         "diagnostic: the bound on what carrying the edges across the events could gain; its "
         "regions lack the events' safety net); *without event samples or birth checks*: the birth "
