@@ -118,7 +118,8 @@ class BirthChecks:
         sa, sb = r.frame(a)[0], r.frame(b)[0]
         (qa, qm), (_, qb) = halves
         u1, u2 = self._eroded_shadow(qa, qm), self._eroded_shadow(qm, qb)
-        if len(self._born(u1, sa, sa)) or len(self._born(u2, sb, sb)):
+        none = shapely.Polygon()
+        if len(self._born(u1, sa, none)) or len(self._born(u2, sb, none)):
             return False
         g = self.shadow_grid
         left = union_all(list(born), grid_size=g)

@@ -19,6 +19,7 @@ from geometry import sweep as S
 from geometry._common import scene_domain
 from geometry._shapes import ccw_ring
 from geometry._shapes import cross as _cross
+from geometry._sweep import births as B
 from geometry._sweep import events as E
 from geometry.fuzz import fuzz_scene
 from sensorplan_gym.core.scenes import load_scene
@@ -524,8 +525,6 @@ def test_a_birth_alarm_whose_bisection_would_find_nothing_takes_no_sample(
     and every placement of the region that the rule adds (vertices and interior points of the
     difference) is seen at configurations densely spaced on the boundary of G (the exact
     point test of the sweep), so the rule drops no shadow."""
-    from geometry._sweep import births as B
-
     settled: list[tuple] = []
     unions: dict[int, shapely.Geometry] = {}
     orig_settled, orig_union = B.BirthChecks._settled, S._union_pieces
