@@ -228,8 +228,14 @@ class Coverage:
         sample finds it and traces it both ways.  It is taken where the exact point test
         confirms, at that time, a twentieth of the cut edge at either end (the end whose
         neighbour lives on is still right, and the new edge runs from it): a line that
-        bounds no shadow there has no continuation.  Each death (``probed``: key and
-        time, within ``1e-6`` of the sweep) is looked at once."""
+        bounds no shadow there has no continuation.  With the lazy rules the line must also
+        *bound* the shadow along that twentieth: the same test on the mirrored probes (just
+        outside the edge) must find a probe that sees the target.  Where the probes on both
+        sides are blind, the line runs inside a shadow there and carries no edge at that
+        time from that end longer than the probes' offset from it (``h``): the sample would
+        hold no continuation to trace (``willow_south``'s 5.2 query: 6 such samples, none
+        holding an edge on the cut edge's line).  Each death (``probed``: key and time,
+        within ``1e-6`` of the sweep) is looked at once."""
         todo = []
         for edge, t_end, toward in cut:
             key = edge[1]
@@ -252,12 +258,22 @@ class Coverage:
         tp = np.array([[t] for _, t in todo])
         vs, ve = self._ends_many([e for e, _ in todo], tp, q0, dq)  # (E, 1, 2) each
         d = 0.05 * (ve - vs)
-        near = self._valid_many(
-            np.concatenate([vs, ve - d]), np.concatenate([vs + d, ve]), np.vstack([tp, tp]), q0, dq
-        )[:, 0]
+        lo, hi, tt = np.concatenate([vs, ve - d]), np.concatenate([vs + d, ve]), np.vstack([tp, tp])
+        near = self._valid_many(lo, hi, tt, q0, dq)[:, 0]
+        if self.lazy_samples and near.any():  # the line must bound the shadow there
+            k = np.flatnonzero(near)
+            near[k] = self._line_bounds(lo[k], hi[k], tt[k], q0, dq)
         finite = np.isfinite(d).all(axis=(1, 2))
         go = ~finite | near[: len(todo)] | near[len(todo) :]
         return float(tp[np.argmax(go), 0]) if go.any() else None
+
+    def _line_bounds(self, lo: np.ndarray, hi: np.ndarray, ts: np.ndarray, q0, dq) -> np.ndarray:
+        """(E,) bool: does some probe just outside the segments ``lo -> hi`` ((E, 1, 2) each,
+        the shadow on their left) see the target at times ``ts`` ((E, 1))?  The exact point
+        test of :meth:`_valid_many` on the mirrored segments (``hi -> lo``: the same probes on
+        the other side); where it finds every probe blind there too, the segment's line runs
+        inside a shadow and bounds none along it (:meth:`_continuation_gap`)."""
+        return ~self._valid_many(hi, lo, ts, q0, dq)[:, 0]
 
     def _coverage_gap(
         self, ea: list, eb: list, cover: dict, a: float, b: float, confirmed: set
