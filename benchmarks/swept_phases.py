@@ -8,8 +8,8 @@ swept partial query over G (paper 3.2.2-3.2.3, ``partial_region(target_in="goal"
 into the phases of :func:`geometry.sweep.swept_shadows` as its :class:`~geometry.sweep.PhaseClock`
 reports them (median over ``--reps`` calls, each on a freshly loaded scene, after one
 warm-up call), each as a multiple of the stationary partial query on the same scene measured
-in the same run, its calls interleaved with the swept ones (the anchor), with the exact
-stationary shadows ("samples") each phase took:
+in the same run, its calls interleaved with the swept ones and the diagnostics' (the anchor),
+with the exact stationary shadows ("samples") each phase took:
 
 * *K's corners*: the one weak visibility region of K = CH(A + G) that tells which obstacle
   corners can graze a beam into the target;
@@ -77,8 +77,8 @@ def run(reps: int, slow: bool = True) -> dict[str, Any]:
         s = load()
         edges = len(s.bounds) + sum(len(o) for o in s.obstacles)
         partial_region(s, target_at=_pose(s, theta))
-        stationary, runs = [], []
-        for k in range(reps + 1):  # the first call warms up; the two queries interleaved
+        stationary, runs, no_events, bare = [], [], [], []
+        for k in range(reps + 1):  # the first call warms up; all four queries interleaved
             if k:
                 s = load()
                 t0 = time.perf_counter()
@@ -91,9 +91,11 @@ def run(reps: int, slow: bool = True) -> dict[str, Any]:
             total = time.perf_counter() - t0
             if k:
                 runs.append((total, sink["stats"]))
+            for births, times in ((True, no_events), (False, bare)):
+                t = _timed(load, theta, births=births)
+                if k:
+                    times.append(t)
         stats = runs[0][1]
-        no_events = _timed(load, theta, reps, births=True)
-        bare = _timed(load, theta, reps, births=False)
         depth = _depth(load, theta)
         row = {
             "scene": name,
@@ -107,8 +109,8 @@ def run(reps: int, slow: bool = True) -> dict[str, Any]:
             "rest_s": statistics.median(t - sum(st["seconds"].values()) for t, st in runs),
             "phase_samples": {p: stats["phase_samples"].get(p, 0) for p in PHASES},
             "samples": sum(stats["phase_samples"].values()),
-            "no_events_s": no_events,
-            "bare_s": bare,
+            "no_events_s": statistics.median(no_events),
+            "bare_s": statistics.median(bare),
             "bare_depth_tol": depth,
         }
         rows.append(row)
@@ -123,21 +125,16 @@ def run(reps: int, slow: bool = True) -> dict[str, Any]:
     return {"reps": reps, "rows": rows}
 
 
-def _timed(load, theta: float, reps: int, *, births: bool) -> float:
-    """Median seconds of the swept query over G (``reps`` calls after a warm-up, each on a
-    freshly loaded scene) with the samples next to the collinearity events switched off and,
-    unless ``births``, the birth checks too."""
-    times = []
+def _timed(load, theta: float, *, births: bool) -> float:
+    """Seconds of one swept query over G on a freshly loaded scene with the samples next to
+    the collinearity events switched off and, unless ``births``, the birth checks too."""
     with contextlib.ExitStack() as stack:
         for patch in _off(births):
             stack.enter_context(patch)
-        for k in range(reps + 1):
-            s = load()
-            t0 = time.perf_counter()
-            _swept_region(s, "goal", theta, 0.0, 0.0, None, False)
-            if k:
-                times.append(time.perf_counter() - t0)
-    return statistics.median(times)
+        s = load()
+        t0 = time.perf_counter()
+        _swept_region(s, "goal", theta, 0.0, 0.0, None, False)
+        return time.perf_counter() - t0
 
 
 def _off(births: bool) -> list:
@@ -201,8 +198,9 @@ def render(data: dict[str, Any]) -> str:
         "",
         f"`{data['command']}`: medians of {data['reps']} calls, each on a freshly loaded scene "
         "(after one warm-up call), each phase as a multiple of the stationary partial query on "
-        "the same scene in the same run, interleaved with the swept calls (its median in the "
-        "third column; the phases' medians need not add up to the query's); in parentheses the "
+        "the same scene in the same run, its calls interleaved with those of the swept query "
+        "and of the two diagnostics (its median in the third column; the phases' medians need "
+        "not add up to the query's); in parentheses the "
         "exact stationary shadows (samples) the phase took; *rest*: the query's own work around "
         "the sweep (the scene's domain, the final difference); *without event samples*: the whole "
         "swept query with the samples next to the collinearity events switched off (a "
