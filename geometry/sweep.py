@@ -140,7 +140,7 @@ class _Run:
     """One segment ``q0 -> q1`` of a sweep (:meth:`Sweeper.along_many`): its sample times
     and their frames (time -> (shadow, edges), shared through the sweeper's cache by the
     segments meeting at a vertex of G), its events (:meth:`Sweeper._events`), the events
-    already found live and its counters."""
+    already found live, its closed intervals and its counters."""
 
     sw: Sweeper
     q0: np.ndarray
@@ -151,9 +151,27 @@ class _Run:
     ev_t: np.ndarray = field(default_factory=lambda: np.zeros(0))
     ev_ids: list = field(default_factory=list)
     ev_side: list = field(default_factory=list)
+    #: intervals (a, b) between samples whose shadows hold every shadow in between
+    #: (:meth:`closes`): nothing to trace or sample there
+    closed: set[tuple[float, float]] = field(default_factory=set)
+    #: the birth check's upper bounds of intervals (a, b) where it found no birth
+    bounds: dict[tuple[float, float], shapely.Geometry] = field(default_factory=dict)
+    #: intervals whose bound was tested for :meth:`closes`
+    tested: set[tuple[float, float]] = field(default_factory=set)
 
     def __post_init__(self) -> None:
         self.dq = self.q1 - self.q0
+
+    def closes(self, a: float, b: float) -> bool:
+        """Whether the interval ``(a, b)`` between two consecutive samples is closed
+        (:meth:`Sweeper._closes` on the birth check's bound of it, where it has one; tested
+        once, and added to :attr:`closed`)."""
+        if (a, b) not in self.tested:
+            self.tested.add((a, b))
+            upper = self.bounds.get((a, b))
+            if upper is not None and self.sw._closes(self, a, b, upper):
+                self.closed.add((a, b))
+        return (a, b) in self.closed
 
     def frame(self, t: float) -> tuple:
         """(shadow, edges) at time ``t`` (:meth:`Sweeper.shadow`, :meth:`Sweeper._edges`),
@@ -398,7 +416,7 @@ class Sweeper(StationaryShadows, PointTest, CollinearityEvents, Coverage, BirthC
                 r.ev_t, r.ev_ids, r.ev_side = self._events(r.q0, r.dq)
             while True:
                 asked = [
-                    (r, self._live_mids(r.ev_t, r.ev_ids, r.frames, r.looked, r.ev_side))
+                    (r, self._live_mids(r.ev_t, r.ev_ids, r.frames, r.looked, r.ev_side, r.closes))
                     for r in moving
                 ]
                 asked = [(r, mids) for r, mids in asked if mids]
@@ -410,7 +428,7 @@ class Sweeper(StationaryShadows, PointTest, CollinearityEvents, Coverage, BirthC
                         r.frame(t)
         with clock("tracing"):
             # the first round of every segment's traces in one batch
-            jobs = [(r.q0, r.q1, r.frame, _pairs(sorted(r.frames))) for r in moving]
+            jobs = [(r.q0, r.q1, r.frame, _open_pairs(r)) for r in moving]
             first = dict(zip(map(id, moving), self._interval_traces(jobs), strict=True))
         out = []
         for i, r in enumerate(runs):
@@ -430,11 +448,13 @@ class Sweeper(StationaryShadows, PointTest, CollinearityEvents, Coverage, BirthC
         ts = sorted(run.frames)
         pieces = [frame(t)[0] for t in ts]
         state = _Cover()
-        todo = [(a, b, 0) for a, b in _pairs(ts)]
+        todo = [(a, b, 0) for a, b in _open_pairs(run)]
         while True:
             self._sweep_intervals(todo, q0, q1, frame, pieces, state, stats, pre)
             pre = None
-            mids = self._live_mids(run.ev_t, run.ev_ids, run.frames, run.looked, run.ev_side)
+            mids = self._live_mids(
+                run.ev_t, run.ev_ids, run.frames, run.looked, run.ev_side, run.closes
+            )
             if not mids:
                 return pieces
             self._prefetch([q0 + t * dq for t in mids])
@@ -559,6 +579,11 @@ class Sweeper(StationaryShadows, PointTest, CollinearityEvents, Coverage, BirthC
     def _check_time(self) -> None:
         if self.deadline is not None and time.monotonic() > self.deadline:
             raise _Expired
+
+
+def _open_pairs(run: _Run) -> list[tuple[float, float]]:
+    """The intervals between the run's consecutive sample times that are not closed."""
+    return [ab for ab in _pairs(sorted(run.frames)) if ab not in run.closed]
 
 
 def _pairs(ts: list[float]) -> list[tuple[float, float]]:

@@ -70,6 +70,8 @@ class BirthChecks:
                     new = len(born) > 0
                     if new and i not in split and self._halves_checked(r, a, b, depth):
                         alarms.append((i, born))  # decided below, in one batch
+                    elif not new:
+                        r.bounds[(a, b)] = upper  # for _Run.closes
                 if new:
                     mids.append((r, a, 0.5 * (a + b), b, depth))
                     new_at.append(i)
@@ -85,6 +87,25 @@ class BirthChecks:
                 r.frame(m)
                 r.stats["refined"] += 1
                 todo += [(r, a, m, depth + 1), (r, m, b, depth + 1)]
+
+    def _closes(self, r, a: float, b: float, upper: shapely.Geometry) -> bool:
+        """Whether the interval ``[a, b]`` between two samples of the run ``r`` is *closed*:
+        its upper bound ``upper`` (every S(q) of the interval lies in it: the eroded target's
+        shadow, or the union of its pieces') lies in S_a u S_b but for parts narrower than the
+        union's grid (as :meth:`_born` counts).  Then every shadow of the interval lies in
+        the two samples' shadows, which the union holds: the interval needs no tracing, no
+        refinement and no event sample, whatever is born or dies in it.  Lazy rules, and not
+        with overlap strips (5.2): there ``upper`` bounds the full target's shadows, not the
+        larger ones of the wanted pieces.  ``S_a u S_b = F - (X_a n X_b)`` and ``upper`` lies
+        in ``F``, so its part outside is ``upper n X_a n X_b`` (:meth:`_seen_pair`, which the
+        tracing of an open interval uses too)."""
+        if not self.lazy_samples or self.strips is not None:
+            return False
+        seen = self._seen_pair(*(self._frame_key(r.q0, r.q1, t) for t in (a, b)))
+        if seen is None:
+            return False
+        parts = shapely.get_parts(areal(snapped(shapely.intersection, upper, seen, self.grid)))
+        return not (2.0 * shapely.area(parts) > self.grid * shapely.length(parts)).any()
 
     def _halves(self, r, a: float, b: float) -> list[tuple[np.ndarray, np.ndarray]]:
         """The two halves ``(qa, qm), (qm, qb)`` of the interval ``[a, b]`` of the run ``r``."""

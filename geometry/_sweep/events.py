@@ -7,6 +7,8 @@ segment continuing a known shadow edge.  Part of :class:`geometry.sweep.Sweeper`
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 import shapely
 
@@ -20,7 +22,13 @@ class CollinearityEvents:
     the samples :meth:`_live_mids` asks for next to them."""
 
     def _live_mids(
-        self, ev_t: np.ndarray, ev_ids: list, frames: dict, looked: set, ev_side: list | None = None
+        self,
+        ev_t: np.ndarray,
+        ev_ids: list,
+        frames: dict,
+        looked: set,
+        ev_side: list | None = None,
+        closes: Callable[[float, float], bool] | None = None,
     ) -> list[float]:
         """The sample times (sorted, not sampled yet) that the collinearity events
         :meth:`_events` asks for now: the midpoint of each interval between consecutive
@@ -39,7 +47,10 @@ class CollinearityEvents:
         tuple of ``ev_ids``: the sides of the event (-1 before, 1 after) where its wedge can
         be a shadow, whose intervals a live event has sampled (None: both).  The caller
         samples, then asks again (the new samples can make more events live); each side of
-        an event is looked at until it is live once (``looked``: ``(event, side)``)."""
+        an event is looked at until it is live once (``looked``: ``(event, side)``).  No
+        sample is asked for inside an interval ``(a, b)`` between two samples where
+        ``closes(a, b)`` (:meth:`~geometry._sweep.births.BirthChecks._closes`: its two samples'
+        shadows hold every shadow in between, the wedge's too)."""
         bounds = np.concatenate([[0.0], ev_t, [1.0]])
         if not self.lazy_samples:  # the previous rule: once between every two events, at once
             if looked:
@@ -63,7 +74,7 @@ class CollinearityEvents:
             for side in sorted(sides - {s for e, s in looked if e == k}):
                 looked.add((k, side))
                 lo, hi = (bounds[k], bounds[k + 1]) if side < 0 else (bounds[k + 1], bounds[k + 2])
-                if not ((times > lo) & (times < hi)).any():
+                if not ((times > lo) & (times < hi)).any() and not _inside(times, lo, hi, closes):
                     out.add(float(0.5 * (lo + hi)))
         return sorted(out)
 
@@ -454,6 +465,17 @@ def _side(w: np.ndarray, v: np.ndarray, rel: float = 1e-9) -> np.ndarray:
     lw = np.hypot(w[..., 0], w[..., 1])
     zero = np.abs(c) <= rel * lw * np.hypot(v[..., 0], v[..., 1])
     return np.where(zero, 0, np.sign(c)).astype(int)
+
+
+def _inside(
+    times: np.ndarray, lo: float, hi: float, closes: Callable[[float, float], bool] | None
+) -> bool:
+    """Does the interval ``[lo, hi]`` (holding no sample time strictly inside) lie in an
+    interval between two consecutive sample times of ``times`` (sorted) that ``closes``?"""
+    if closes is None:
+        return False
+    k = int(np.searchsorted(times, lo, side="right"))
+    return 0 < k < len(times) and closes(float(times[k - 1]), float(times[k]))
 
 
 def _between(s_: np.ndarray, pair: np.ndarray, tol: float) -> np.ndarray:
