@@ -94,18 +94,33 @@ class BirthChecks:
         shadow, or the union of its pieces') lies in S_a u S_b but for parts narrower than the
         union's grid (as :meth:`_born` counts).  Then every shadow of the interval lies in
         the two samples' shadows, which the union holds: the interval needs no tracing, no
-        refinement and no event sample, whatever is born or dies in it.  Lazy rules, and not
-        with overlap strips (5.2): there ``upper`` bounds the full target's shadows, not the
-        larger ones of the wanted pieces.  ``S_a u S_b = F - (X_a n X_b)`` and ``upper`` lies
-        in ``F``, so its part outside is ``upper n X_a n X_b`` (:meth:`_seen_pair`, which the
-        tracing of an open interval uses too)."""
-        if not self.lazy_samples or self.strips is not None:
+        refinement and no event sample, whatever is born or dies in it.  Lazy rules only.
+        With overlap strips (5.2) ``upper`` bounds the full target's shadows, not the larger
+        ones of the wanted pieces: there only where no strip comes within ``1e-6`` of the
+        scene's size of the area its edge sweeps over the interval (:meth:`_strips_miss`), so
+        that the whole outline is wanted all along and the shadows are the full ones.
+        ``S_a u S_b = F - (X_a n X_b)`` and ``upper`` lies in ``F``, so its part outside is
+        ``upper n X_a n X_b`` (:meth:`_seen_pair`, which the tracing of an open interval uses
+        too)."""
+        if not self.lazy_samples or (self.strips is not None and not self._strips_miss(r, a, b)):
             return False
         seen = self._seen_pair(*(self._frame_key(r.q0, r.q1, t) for t in (a, b)))
         if seen is None:
             return False
         parts = shapely.get_parts(areal(snapped(shapely.intersection, upper, seen, self.grid)))
         return not (2.0 * shapely.area(parts) > self.grid * shapely.length(parts)).any()
+
+    def _strips_miss(self, r, a: float, b: float) -> bool:
+        """Whether no overlap strip comes within ``1e-6`` of the scene's size of the area its
+        target edge sweeps while the target moves over ``[a, b]`` of the run ``r`` (the
+        parallelogram between the edge's two positions): the whole outline is wanted at every
+        configuration of the interval."""
+        qa, qb = (r.q1 if t == 1.0 else r.q0 + t * r.dq for t in (a, b))
+        ring, nxt = self.ring0, np.roll(self.ring0, -1, axis=0)
+        swept = shapely.polygons(np.stack([ring + qa, nxt + qa, nxt + qb, ring + qb], axis=1))
+        swept = shapely.convex_hull(swept)  # an edge along the motion: a degenerate one
+        near = shapely.dwithin(self._strip_array(), swept, 1e-6 * self.env.scale)
+        return not near.any()
 
     def _halves(self, r, a: float, b: float) -> list[tuple[np.ndarray, np.ndarray]]:
         """The two halves ``(qa, qm), (qm, qb)`` of the interval ``[a, b]`` of the run ``r``."""

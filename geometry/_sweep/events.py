@@ -303,12 +303,7 @@ class CollinearityEvents:
         """Per row, with the target at reference point ``q[r]``: is every point of its
         outline within ``1e-6`` of the scene's size of vertex ``v[r]`` wanted (no strip of
         its two edges comes that near), or with ``edge``, every point of edge ``v[r]``?"""
-        arr = getattr(self, "_strip_arr", None)
-        if arr is None:  # one object per edge (the trailing None keeps numpy from nesting)
-            arr = self._strip_arr = np.array(
-                [None if u is None or u.is_empty else u for u in self.strips] + [None],
-                dtype=object,
-            )[:-1]
+        arr = self._strip_array()
         m, r0 = self.m, self.ring0
         if edge:
             geom = shapely.linestrings(np.stack([r0[v] + q, r0[(v + 1) % m] + q], axis=1))
@@ -321,6 +316,17 @@ class CollinearityEvents:
             d = shapely.distance(arr[i], geom)
             ok &= ~(d <= 1e-6 * self.env.scale)  # NaN: no strip, the whole edge wanted
         return ok
+
+    def _strip_array(self) -> np.ndarray:
+        """The overlap strips (``strips``), one object per target edge, None where it has
+        none (cached)."""
+        arr = getattr(self, "_strip_arr", None)
+        if arr is None:  # the trailing None keeps numpy from nesting
+            arr = self._strip_arr = np.array(
+                [None if u is None or u.is_empty else u for u in self.strips] + [None],
+                dtype=object,
+            )[:-1]
+        return arr
 
     def _obstacle_side(self, v: np.ndarray, other: np.ndarray, w: np.ndarray) -> np.ndarray:
         """Per row: the side (1 left, -1 right, :func:`_side`) of the line of direction ``w``

@@ -655,17 +655,27 @@ def test_a_continuation_sample_is_taken_only_where_the_cut_line_bounds_the_shado
         assert n_got < n_ref
 
 
-@pytest.mark.parametrize("name", ["real/willow_north", "fuzz:200079", "fuzz:200103"])
+@pytest.mark.parametrize(
+    ("name", "query"),
+    [
+        ("real/willow_north", "swept"),
+        ("fuzz:200079", "swept"),
+        ("fuzz:200103", "swept"),
+        ("real/willow_north", "recognizable"),
+    ],
+)
 def test_an_interval_whose_bound_lies_in_its_samples_shadows_takes_no_event_sample(
-    name, monkeypatch
+    name, query, monkeypatch
 ) -> None:
     """Where the birth check's upper bound of an interval between two samples lies in their
     two shadows (:meth:`~geometry._sweep.births.BirthChecks._closes`), every shadow in between
     does too: the interval is closed, and the event samples it would take and its tracing are
     left out.  Checked against shadows computed afresh at seven times inside every closed
     interval: none has a part wider than the union's grid outside the two samples' shadows;
-    no sample lies inside a closed interval; each scene closes one (not vacuous).  Without the
-    rule the swept regions are within the bounds of the other lazy rules
+    no sample lies inside a closed interval; each scene closes one (not vacuous).  In the 5.2
+    sweeps an interval closes only where no overlap strip comes near the target's edges
+    (:meth:`~geometry._sweep.births.BirthChecks._strips_miss`; on ``willow_north`` G and H are
+    apart).  Without the rule the regions are within the bounds of the other lazy rules
     (:func:`_assert_close`) and take more samples."""
     asked: list[tuple] = []
     orig = S._Run.closes
@@ -677,12 +687,14 @@ def test_an_interval_whose_bound_lies_in_its_samples_shadows_takes_no_event_samp
 
     kw = {"theta": 0.0, "timeout": None, "conservative": True}
 
-    def query():
-        return {"swept": partial_region(_scene(name), target_in="goal", **kw)}
+    def run():
+        if query == "swept":
+            return {"swept": partial_region(_scene(name), target_in="goal", **kw)}
+        return {"recognizable": recognizable_region(_scene(name), model="partial", **kw)}
 
     with monkeypatch.context() as m:
         m.setattr(S._Run, "closes", spy)
-        got = _with_rule(True, query, monkeypatch)
+        got = _with_rule(True, run, monkeypatch)
     closed = {(id(r), a, b): (r, a, b) for r, a, b, ok in asked if ok}
     assert closed
     for r, a, b in closed.values():
@@ -695,33 +707,81 @@ def test_an_interval_whose_bound_lies_in_its_samples_shadows_takes_no_event_samp
             assert not wide.any(), (name, a, b, t)
     with monkeypatch.context() as m:
         m.setattr(B.BirthChecks, "_closes", lambda self, *a: False)
-        ref = _with_rule(True, query, monkeypatch)
+        ref = _with_rule(True, run, monkeypatch)
     _assert_close(name, got[0], ref[0])
     n_got, n_ref = (sum(len(sw._frames) for sw in made) for _, made in (got, ref))
     assert n_got < n_ref
 
 
 @pytest.mark.parametrize(
-    "name",
+    ("name", "query"),
     [
-        "fuzz:200326",
-        "fuzz-disagree-P_swept-lib_in_truth_out",
-        "fuzz-inclusion-swept_partial__stationary_partial_aux_",
+        ("fuzz:200326", "swept"),
+        ("fuzz-disagree-P_swept-lib_in_truth_out", "swept"),
+        ("fuzz-inclusion-swept_partial__stationary_partial_aux_", "swept"),
+        ("fuzz:200007", "recognizable"),
+        ("fuzz:200073", "recognizable"),
     ],
 )
-def test_an_interval_holding_a_wedge_stays_open(name, monkeypatch) -> None:
+def test_an_interval_holding_a_wedge_stays_open(name, query, monkeypatch) -> None:
     """On the scenes whose event samples catch a wedge (leaving them out costs 400-1,000
-    ``tol`` of the swept region), the interval that holds the wedge is not closed: its bound
-    reaches outside its samples' shadows (:meth:`~geometry._sweep.births.BirthChecks._closes`),
-    and the swept region is that of the sweep without closed intervals.  (Closing every
-    interval with a bound misses the wedge: the check fails then.)"""
+    ``tol`` of the swept region, 4-6 ``tol`` of the 5.2 one), the interval that holds the
+    wedge is not closed: its bound reaches outside its samples' shadows
+    (:meth:`~geometry._sweep.births.BirthChecks._closes`), and the region is that of the sweep
+    without closed intervals.  (Closing every interval with a bound misses the wedge: the
+    check fails then.)"""
     kw = {"theta": 0.0, "timeout": None, "conservative": True}
 
-    def query():
-        return {"swept": partial_region(_scene(name), target_in="goal", **kw)}
+    def run():
+        if query == "swept":
+            return {"swept": partial_region(_scene(name), target_in="goal", **kw)}
+        return {"recognizable": recognizable_region(_scene(name), model="partial", **kw)}
 
-    got = _with_rule(True, query, monkeypatch)
+    got = _with_rule(True, run, monkeypatch)
     with monkeypatch.context() as m:
         m.setattr(B.BirthChecks, "_closes", lambda self, *a: False)
-        ref = _with_rule(True, query, monkeypatch)
+        ref = _with_rule(True, run, monkeypatch)
     _assert_close(name, got[0], ref[0])
+
+
+def test_a_5_2_interval_closes_only_where_no_strip_meets_its_edges(monkeypatch) -> None:
+    """In the 5.2 sweeps the birth check's bound holds the full target's shadows only: an
+    interval closes only where no overlap strip comes near the area a target edge sweeps
+    over it (:meth:`~geometry._sweep.births.BirthChecks._strips_miss`), where the whole
+    outline is wanted at every configuration.  On ``lab`` with G and H side by side (the
+    target's edges parallel to their common side overlap across it): wherever the test says
+    the strips miss, the outline is wanted all over at nine configurations of the interval;
+    it says they meet on some interval whose configurations have unwanted pieces; and the 5.2
+    region is that of the sweep without closed intervals.  (Closing there as in the plain
+    sweep leaves 30 ``tol`` too much region: the check fails then.)"""
+    d = json.loads((Path(S.__file__).parents[1] / "sensorplan_gym/scenes/lab.json").read_text())
+    d["goal"] = [[6.2, 4.0], [6.6, 4.0], [6.6, 4.4], [6.2, 4.4]]
+    d["failure"] = [[6.65, 4.0], [7.0, 4.0], [7.0, 4.4], [6.65, 4.4]]
+    seen: list[tuple] = []
+    orig = B.BirthChecks._strips_miss
+
+    def spy(self, r, a, b):
+        got = orig(self, r, a, b)
+        seen.append((self, r, a, b, got))
+        return got
+
+    kw = {"theta": 0.0, "timeout": None, "conservative": True}
+
+    def run():
+        return {"recognizable": recognizable_region(Scene.from_dict(d), model="partial", **kw)}
+
+    with monkeypatch.context() as m:
+        m.setattr(B.BirthChecks, "_strips_miss", spy)
+        got = _with_rule(True, run, monkeypatch)
+    met = 0
+    for sw, r, a, b, miss in seen:
+        wanted = [sw.outline(r.q0 + t * r.dq)[1].all() for t in np.linspace(a, b, 9)]
+        if miss:
+            assert all(wanted), (a, b)
+        else:
+            met += not all(wanted)
+    assert met
+    with monkeypatch.context() as m:
+        m.setattr(B.BirthChecks, "_closes", lambda self, *a: False)
+        ref = _with_rule(True, run, monkeypatch)
+    _assert_close("lab", got[0], ref[0])
