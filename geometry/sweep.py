@@ -151,13 +151,11 @@ class _Run:
     ev_t: np.ndarray = field(default_factory=lambda: np.zeros(0))
     ev_ids: list = field(default_factory=list)
     ev_side: list = field(default_factory=list)
-    #: intervals (a, b) between samples whose shadows hold every shadow in between
-    #: (:meth:`closes`): nothing to trace or sample there
-    closed: set[tuple[float, float]] = field(default_factory=set)
     #: the birth check's upper bounds of intervals (a, b) where it found no birth
     bounds: dict[tuple[float, float], shapely.Geometry] = field(default_factory=dict)
-    #: intervals whose bound was tested for :meth:`closes`
-    tested: set[tuple[float, float]] = field(default_factory=set)
+    #: per interval (a, b) tested: is it closed (:meth:`closes`; closed: its samples'
+    #: shadows hold every shadow in between, nothing to trace or sample there)
+    closed: dict[tuple[float, float], bool] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         self.dq = self.q1 - self.q0
@@ -165,13 +163,12 @@ class _Run:
     def closes(self, a: float, b: float) -> bool:
         """Whether the interval ``(a, b)`` between two consecutive samples is closed
         (:meth:`Sweeper._closes` on the birth check's bound of it, where it has one; tested
-        once, and added to :attr:`closed`)."""
-        if (a, b) not in self.tested:
-            self.tested.add((a, b))
+        once, kept in :attr:`closed`)."""
+        got = self.closed.get((a, b))
+        if got is None:
             upper = self.bounds.get((a, b))
-            if upper is not None and self.sw._closes(self, a, b, upper):
-                self.closed.add((a, b))
-        return (a, b) in self.closed
+            got = self.closed[(a, b)] = upper is not None and self.sw._closes(self, a, b, upper)
+        return got
 
     def frame(self, t: float) -> tuple:
         """(shadow, edges) at time ``t`` (:meth:`Sweeper.shadow`, :meth:`Sweeper._edges`),
@@ -583,7 +580,7 @@ class Sweeper(StationaryShadows, PointTest, CollinearityEvents, Coverage, BirthC
 
 def _open_pairs(run: _Run) -> list[tuple[float, float]]:
     """The intervals between the run's consecutive sample times that are not closed."""
-    return [ab for ab in _pairs(sorted(run.frames)) if ab not in run.closed]
+    return [ab for ab in _pairs(sorted(run.frames)) if not run.closed.get(ab, False)]
 
 
 def _pairs(ts: list[float]) -> list[tuple[float, float]]:
