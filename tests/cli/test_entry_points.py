@@ -5,6 +5,7 @@ with an ``if __name__ == "__main__":`` block (and every package ``__main__.py``)
 from __future__ import annotations
 
 import ast
+import json
 import os
 import subprocess
 import sys
@@ -56,20 +57,31 @@ def test_the_entry_points_are_found():
     assert "agents.planning.oracle" not in found
 
 
-@pytest.mark.parametrize("module", entry_points())
-def test_help_prints_usage_and_exits_0(module, tmp_path):
+@pytest.fixture(scope="module")
+def help_runs(tmp_path_factory) -> dict[str, list]:
+    """``python -m MODULE --help`` for every entry point, each in a child forked from one fresh
+    interpreter that imported the heavy libraries once (``tests/cli/_help_runner.py``), from an
+    empty folder (a module that ignored ``--help`` and started writing would leave files there,
+    and would be killed after 120 s on its real workload): per module its exit status, stdout,
+    stderr and the files it left."""
+    out = tmp_path_factory.mktemp("help") / "runs.json"
+    code = "import json, sys; from tests.cli._help_runner import run; "
+    code += "json.dump(run(sys.argv[2:]), open(sys.argv[1], 'w'))"
     env = {**os.environ, "MPLBACKEND": "Agg", "PYTHONPATH": str(ROOT)}
-    # run from an empty folder: a module that ignored --help and started writing would
-    # leave files here, and would not finish within the timeout on its real workload
-    proc = subprocess.run(
-        [sys.executable, "-m", module, "--help"],
-        capture_output=True,
-        text=True,
-        timeout=120,
-        cwd=tmp_path,
+    subprocess.run(
+        [sys.executable, "-c", code, str(out), *entry_points()],
+        check=True,
+        timeout=60 * len(entry_points()),
+        cwd=ROOT,
         env=env,
     )
-    assert proc.returncode == 0, proc.stderr[-2000:]
+    return json.loads(out.read_text())
+
+
+@pytest.mark.parametrize("module", entry_points())
+def test_help_prints_usage_and_exits_0(module, help_runs):
+    rc, stdout, stderr, left = help_runs[module]
+    assert rc == 0, stderr[-2000:]
     prog = PROG.get(module, f"python -m {module}")
-    assert proc.stdout.lstrip().startswith(f"usage: {prog} "), proc.stdout[:300]
-    assert list(tmp_path.iterdir()) == [], "--help wrote files"
+    assert stdout.lstrip().startswith(f"usage: {prog} "), stdout[:300]
+    assert left == [], "--help wrote files"
