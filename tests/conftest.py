@@ -21,6 +21,26 @@ settings.load_profile("ci" if os.environ.get("CI") else "dev")
 # pass a temporary folder explicitly).
 os.environ["SENSORPLAN_GYM_CACHE"] = "off"
 
+
+def pytest_addoption(parser: pytest.Parser) -> None:
+    parser.addoption(
+        "--slow",
+        action="store_true",
+        help="also run the slow tier: the tests marked slow (end-to-end training and Ray-cluster "
+        "runs of the benchmark commands; .ci/run runs them with `--slow -m slow`)",
+    )
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """Tests marked ``slow`` are skipped unless ``--slow`` is given (README, "Tests")."""
+    if config.getoption("--slow"):
+        return
+    skip = pytest.mark.skip(reason="slow tier: run with --slow (.ci/run does)")
+    for item in items:
+        if "slow" in item.keywords:
+            item.add_marker(skip)
+
+
 #: A small valid scene (JSON form): a 10 x 10 room, two touching obstacles,
 #: a unit-square target, a square goal and a point failure region.
 LAB: dict[str, Any] = {

@@ -9,6 +9,7 @@ import pytest
 from benchmarks import fuzz_swept
 
 
+@pytest.mark.slow
 def test_runs_in_chunks_and_resumes(tmp_path, monkeypatch):
     chunks, out = tmp_path / "chunks", tmp_path / "out"
     argv = ["--n", "3", "--seed", "203869", "--chunk", "2", "--chunks", str(chunks)]

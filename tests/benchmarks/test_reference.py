@@ -162,6 +162,7 @@ _TINY_ARGS = [
 ]  # fmt: skip
 
 
+@pytest.mark.slow
 def test_a_killed_grid_restarts_with_its_unfinished_runs(tmp_path, monkeypatch, capsys):
     """``train`` killed (SIGKILL) right after its first run finished: the finished run is
     whole and kept, a rerun trains only the others and leaves no half-written folder."""

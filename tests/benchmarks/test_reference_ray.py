@@ -43,6 +43,7 @@ def _main(capsys, *argv: str) -> tuple[int, str]:
     return rc, capsys.readouterr().out
 
 
+@pytest.mark.slow
 def test_tiny_grid_on_local_ray_resumes(tmp_path, monkeypatch, capsys):
     """One test, so that pytest-xdist never starts two Ray instances of this module."""
     monkeypatch.chdir(tmp_path)  # runs/ relative to here

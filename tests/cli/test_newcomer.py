@@ -80,6 +80,7 @@ def test_fine_scene_start_is_kept():
         assert u.start == tuple(float(v) for v in load_scene(scene).start)
 
 
+@pytest.mark.slow
 def test_oracle_benchmark_leaves_the_tracked_results_alone(tmp_path, monkeypatch):
     import benchmarks._results as br
     import benchmarks.oracle as bo

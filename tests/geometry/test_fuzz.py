@@ -120,7 +120,7 @@ def test_generator_makes_valid_degenerate_scenes():
 @pytest.mark.slow
 @pytest.mark.skipif(
     not os.environ.get("SENSORPLAN_SLOW"),
-    reason="long: set SENSORPLAN_SLOW=1 (and use -m slow) to run",
+    reason="long: set SENSORPLAN_SLOW=1 and pass --slow to run",
 )
 def test_fuzz_long():
     res = run_many(int(os.environ.get("SENSORPLAN_FUZZ_N", "10000")), seed=10_000)

@@ -478,7 +478,7 @@ def test_eps_regions_agree_with_oracle():
 @pytest.mark.slow
 @pytest.mark.skipif(
     not os.environ.get("SENSORPLAN_SLOW"),
-    reason="minutes long: set SENSORPLAN_SLOW=1 (and use -m slow) to run",
+    reason="minutes long: set SENSORPLAN_SLOW=1 and pass --slow to run",
 )
 def test_regions_agree_with_oracle_many_scenes():
     seeds = range(N_SCENES, N_SCENES + SLOW_SCENES)

@@ -41,6 +41,7 @@ def test_shipped_policy_loads_and_acts(cfg):
     assert env.action_space.contains(np.asarray(a, dtype=env.action_space.dtype))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("cfg", SHIPPED, ids=lambda p: p.stem)
 def test_shipped_config_trains_bit_identically_twice(cfg, tmp_path):
     rec = yaml.safe_load(cfg.read_text())
