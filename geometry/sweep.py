@@ -44,8 +44,9 @@ between), and once between consecutive *collinearity events* (:meth:`Sweeper._ev
 a moving anchor crossing a line through two obstacle corners or an obstacle edge, a line
 through two target vertices crossing a corner), where a shadow can be born as a segment
 that continues a known shadow edge (issue 26.3, 26.4) -- next to the events whose lines
-carry a shadow edge at some sample (:meth:`Sweeper._live_mids`) --, and just after a traced edge was
-cut short by the death of a neighbour while its line still bounds a shadow (the edge goes
+carry a shadow edge at some sample (:meth:`Sweeper._live_mids`; not in the first or last interval
+where the sample at the segment's end stands in, :meth:`Sweeper._ends_clear`) --, and just after a
+traced edge was cut short by the death of a neighbour while its line still bounds a shadow (the edge goes
 on with another neighbour, a configuration that may live between two samples only:
 :meth:`Sweeper._continuation_gap`).  What this does not prove is listed in
 docs/DESIGN.md.
@@ -151,6 +152,9 @@ class _Run:
     ev_t: np.ndarray = field(default_factory=lambda: np.zeros(0))
     ev_ids: list = field(default_factory=list)
     ev_side: list = field(default_factory=list)
+    #: whether the samples at 0 and 1 stand in for the first and last interval's event
+    #: samples (:meth:`Sweeper._ends_clear`; computed when first asked, :meth:`ends_clear`)
+    ends: tuple[bool, bool] | None = None
     #: the birth check's upper bounds of intervals (a, b) where it found no birth
     bounds: dict[tuple[float, float], shapely.Geometry] = field(default_factory=dict)
     #: per interval (a, b) tested: is it closed (:meth:`closes`; closed: its samples'
@@ -169,6 +173,25 @@ class _Run:
             upper = self.bounds.get((a, b))
             got = self.closed[(a, b)] = upper is not None and self.sw._closes(self, a, b, upper)
         return got
+
+    def event_args(self) -> tuple:
+        """The arguments of :meth:`Sweeper._live_mids` for this segment."""
+        return (
+            self.ev_t,
+            self.ev_ids,
+            self.frames,
+            self.looked,
+            self.ev_side,
+            self.closes,
+            self.ends_clear,
+        )
+
+    def ends_clear(self, end: int) -> bool:
+        """Whether the sample at time ``end`` (0 or 1) stands in for the event samples of
+        the first (last) interval between events (:meth:`Sweeper._ends_clear`, once)."""
+        if self.ends is None:
+            self.ends = self.sw._ends_clear(self.q0, self.dq, self.ev_t)
+        return self.ends[end]
 
     def frame(self, t: float) -> tuple:
         """(shadow, edges) at time ``t`` (:meth:`Sweeper.shadow`, :meth:`Sweeper._edges`),
@@ -412,10 +435,7 @@ class Sweeper(StationaryShadows, PointTest, CollinearityEvents, Coverage, BirthC
             for r in moving:
                 r.ev_t, r.ev_ids, r.ev_side = self._events(r.q0, r.dq)
             while True:
-                asked = [
-                    (r, self._live_mids(r.ev_t, r.ev_ids, r.frames, r.looked, r.ev_side, r.closes))
-                    for r in moving
-                ]
+                asked = [(r, self._live_mids(*r.event_args())) for r in moving]
                 asked = [(r, mids) for r, mids in asked if mids]
                 if not asked:
                     break
@@ -449,9 +469,7 @@ class Sweeper(StationaryShadows, PointTest, CollinearityEvents, Coverage, BirthC
         while True:
             self._sweep_intervals(todo, q0, q1, frame, pieces, state, stats, pre)
             pre = None
-            mids = self._live_mids(
-                run.ev_t, run.ev_ids, run.frames, run.looked, run.ev_side, run.closes
-            )
+            mids = self._live_mids(*run.event_args())
             if not mids:
                 return pieces
             self._prefetch([q0 + t * dq for t in mids])

@@ -29,6 +29,7 @@ class CollinearityEvents:
         looked: set,
         ev_side: list | None = None,
         closes: Callable[[float, float], bool] | None = None,
+        ends: Callable[[int], bool] | None = None,
     ) -> list[float]:
         """The sample times (sorted, not sampled yet) that the collinearity events
         :meth:`_events` asks for now: the midpoint of each interval between consecutive
@@ -50,7 +51,9 @@ class CollinearityEvents:
         an event is looked at until it is live once (``looked``: ``(event, side)``).  No
         sample is asked for inside an interval ``(a, b)`` between two samples where
         ``closes(a, b)`` (:meth:`~geometry._sweep.births.BirthChecks._closes`: its two samples'
-        shadows hold every shadow in between, the wedge's too)."""
+        shadows hold every shadow in between, the wedge's too).  Nor inside the first (last)
+        interval between events where ``ends(0)`` (``ends(1)``) holds: the sample at 0 (1)
+        stands in for it (:meth:`_ends_clear`)."""
         bounds = np.concatenate([[0.0], ev_t, [1.0]])
         if not self.lazy_samples:  # the previous rule: once between every two events, at once
             if looked:
@@ -74,12 +77,45 @@ class CollinearityEvents:
             for side in sorted(sides - {s for e, s in looked if e == k}):
                 looked.add((k, side))
                 lo, hi = (bounds[k], bounds[k + 1]) if side < 0 else (bounds[k + 1], bounds[k + 2])
-                if not ((times > lo) & (times < hi)).any() and not _inside(times, lo, hi, closes):
-                    out.add(float(0.5 * (lo + hi)))
+                if ((times > lo) & (times < hi)).any() or _inside(times, lo, hi, closes):
+                    continue
+                if ends is not None and any(
+                    b == end and end in frames and ends(int(end))
+                    for b, end in ((lo, 0.0), (hi, 1.0))
+                ):
+                    continue
+                out.add(float(0.5 * (lo + hi)))
         return sorted(out)
 
+    def _ends_clear(self, q0: np.ndarray, dq: np.ndarray, ev_t: np.ndarray) -> tuple[bool, bool]:
+        """Whether the samples at the ends of the segment ``q0 + t dq`` (t = 0, 1) stand in
+        for the event samples of the first and last interval between its events ``ev_t``
+        (:meth:`_events`; lazy rules only): no event of the motion's line (extended past the
+        segment) lies within half that interval's length before 0 (after 1), or at the end.
+
+        Between consecutive events no wedge is born or dies (they are born and die at
+        events), so a wedge alive in the first interval ``(0, t_1)`` is alive at 0 too, born
+        at least ``t_1 / 2`` before it: at least as old as it would be at the interval's
+        midpoint, the sample the interval takes otherwise (whose worst case is a wedge born
+        at 0), and alive at least ``t_1`` after it.  The sample at 0 then holds it, and its
+        edges are traced from there to its death as any edge of a sample.  The last interval
+        likewise, with the sample at 1 and the events after 1."""
+        if not self.lazy_samples or len(ev_t) == 0:
+            return (False, False)
+        t1, tn = float(ev_t[0]), float(ev_t[-1])
+        before = self._event_window(q0, dq, -0.5 * t1, 2e-9)[0]
+        after = self._event_window(q0, dq, 1 - 2e-9, 1 + 0.5 * (1 - tn))[0]
+        return (len(before) == 0, len(after) == 0)
+
     def _events(self, q0: np.ndarray, dq: np.ndarray) -> tuple[np.ndarray, list, list]:
-        """Times in (0, 1), sorted, at which the target moving along ``q0 + t dq`` meets
+        """:meth:`_event_window` over the segment, times in (0, 1) (1e-9 off its ends)."""
+        return self._event_window(q0, dq, 1e-9, 1 - 1e-9)
+
+    def _event_window(
+        self, q0: np.ndarray, dq: np.ndarray, lo: float, hi: float
+    ) -> tuple[np.ndarray, list, list]:
+        """Times in ``(lo, hi)`` (the line of the motion extended past the segment where
+        outside [0, 1]), sorted, at which the target moving along ``q0 + t dq`` meets
         a *collinearity event*: a moving anchor (target vertex or end of a wanted piece)
         crosses the line through two convex obstacle corners whose joining line is
         tangent at both, or through an obstacle edge; or the line through two target
@@ -127,7 +163,6 @@ class CollinearityEvents:
             wt = self.ring0[kk] - self.ring0[ii]
             a0 = self.ring0 + q0v
             tb = _cross(wt[None], b[:, None, :] - a0[ii][None]) / _cross(wt, dq)[None]
-        lo, hi = 1e-9, 1 - 1e-9
         la, xa = np.nonzero(np.isfinite(ta) & (ta > lo) & (ta < hi))
         ta = ta[la, xa]
         lb, pb = np.nonzero(np.isfinite(tb) & (tb > lo) & (tb < hi))

@@ -785,3 +785,64 @@ def test_a_5_2_interval_closes_only_where_no_strip_meets_its_edges(monkeypatch) 
         m.setattr(B.BirthChecks, "_closes", lambda self, *a: False)
         ref = _with_rule(True, run, monkeypatch)
     _assert_close("lab", got[0], ref[0])
+
+
+@pytest.mark.parametrize(
+    ("name", "query"),
+    [
+        ("real/willow_south", "swept"),
+        ("real/willow_south", "recognizable"),
+        ("real/willow_north", "recognizable"),
+        ("fuzz:200326", "swept"),
+        ("fuzz:200007", "recognizable"),
+        ("fuzz:200073", "recognizable"),
+    ],
+)
+def test_the_end_samples_stand_in_for_the_first_and_last_event_interval(
+    name, query, monkeypatch
+) -> None:
+    """Where no event of the motion's line lies within half the first (last) interval
+    between events before the segment's start (after its end), the sample at the start (end)
+    holds every wedge alive in that interval, as old as the interval's midpoint sample would
+    see it (:meth:`~geometry._sweep.events.CollinearityEvents._ends_clear`): that sample is
+    not taken.  On the Willow Garage maps some are left out, and fewer samples are taken; on
+    every scene (among them those whose event samples catch a wedge, where leaving them all
+    out costs 4-1,000 ``tol``) the regions are those of the sweep without the rule, within
+    :func:`_assert_close`'s bounds.  Where an end stands in, the extended line has no event
+    in the half interval (checked with a wider window of :meth:`_event_window`)."""
+    clear: list[tuple] = []
+    orig = S._Run.ends_clear
+
+    def spy(self, end):
+        got = orig(self, end)
+        clear.append((self, end, got))
+        return got
+
+    kw = {"theta": 0.0, "timeout": None, "conservative": True}
+
+    def run():
+        if query == "swept":
+            return {"swept": partial_region(_scene(name), target_in="goal", **kw)}
+        return {"recognizable": recognizable_region(_scene(name), model="partial", **kw)}
+
+    with monkeypatch.context() as m:
+        m.setattr(S._Run, "ends_clear", spy)
+        got = _with_rule(True, run, monkeypatch)
+    for r, end, ok in clear:
+        if not ok:
+            continue
+        wide, _, _ = r.sw._event_window(r.q0, r.dq, -1.0, 2.0)
+        if end == 0:
+            near = wide[(wide >= -0.5 * r.ev_t[0]) & (wide <= 1e-9)]
+        else:
+            near = wide[(wide >= 1 - 1e-9) & (wide <= 1 + 0.5 * (1 - r.ev_t[-1]))]
+        assert len(near) == 0, (name, end, near)
+    with monkeypatch.context() as m:
+        m.setattr(E.CollinearityEvents, "_ends_clear", lambda self, *a: (False, False))
+        ref = _with_rule(True, run, monkeypatch)
+    _assert_close(name, got[0], ref[0])
+    n_got, n_ref = (sum(len(sw._frames) for sw in made) for _, made in (got, ref))
+    assert n_got <= n_ref
+    if name.startswith("real/"):
+        assert any(ok for _, _, ok in clear)
+        assert n_got < n_ref
