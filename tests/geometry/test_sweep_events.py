@@ -113,6 +113,14 @@ def _with_rule(lazy: bool, fn, monkeypatch):
     return got, made
 
 
+def _query(name: str, query: str) -> dict[str, shapely.Geometry]:
+    """One query of :func:`_queries` (``"swept"`` or ``"recognizable"``) on a fresh scene."""
+    kw = {"theta": 0.0, "timeout": None, "conservative": True}
+    if query == "swept":
+        return {"swept": partial_region(_scene(name), target_in="goal", **kw)}
+    return {"recognizable": recognizable_region(_scene(name), model="partial", **kw)}
+
+
 def _run(name: str, monkeypatch, lazy: bool) -> tuple[dict, list]:
     """The regions with lazy (or eager) sampling, and the Sweepers that made them."""
     return _with_rule(lazy, lambda: _queries(_scene(name)), monkeypatch)
@@ -685,12 +693,8 @@ def test_an_interval_whose_bound_lies_in_its_samples_shadows_takes_no_event_samp
         asked.append((self, a, b, got))
         return got
 
-    kw = {"theta": 0.0, "timeout": None, "conservative": True}
-
     def run():
-        if query == "swept":
-            return {"swept": partial_region(_scene(name), target_in="goal", **kw)}
-        return {"recognizable": recognizable_region(_scene(name), model="partial", **kw)}
+        return _query(name, query)
 
     with monkeypatch.context() as m:
         m.setattr(S._Run, "closes", spy)
@@ -730,12 +734,9 @@ def test_an_interval_holding_a_wedge_stays_open(name, query, monkeypatch) -> Non
     (:meth:`~geometry._sweep.births.BirthChecks._closes`), and the region is that of the sweep
     without closed intervals.  (Closing every interval with a bound misses the wedge: the
     check fails then.)"""
-    kw = {"theta": 0.0, "timeout": None, "conservative": True}
 
     def run():
-        if query == "swept":
-            return {"swept": partial_region(_scene(name), target_in="goal", **kw)}
-        return {"recognizable": recognizable_region(_scene(name), model="partial", **kw)}
+        return _query(name, query)
 
     got = _with_rule(True, run, monkeypatch)
     with monkeypatch.context() as m:
@@ -818,12 +819,8 @@ def test_the_end_samples_stand_in_for_the_first_and_last_event_interval(
         clear.append((self, end, got))
         return got
 
-    kw = {"theta": 0.0, "timeout": None, "conservative": True}
-
     def run():
-        if query == "swept":
-            return {"swept": partial_region(_scene(name), target_in="goal", **kw)}
-        return {"recognizable": recognizable_region(_scene(name), model="partial", **kw)}
+        return _query(name, query)
 
     with monkeypatch.context() as m:
         m.setattr(S._Run, "ends_clear", spy)
