@@ -44,11 +44,11 @@ between), and once between consecutive *collinearity events* (:meth:`Sweeper._ev
 a moving anchor crossing a line through two obstacle corners or an obstacle edge, a line
 through two target vertices crossing a corner), where a shadow can be born as a segment
 that continues a known shadow edge (issue 26.3, 26.4) -- next to the events whose lines
-carry a shadow edge at some sample (:meth:`Sweeper._live_mids`; not in the first or last interval
-where the sample at the segment's end stands in, :meth:`Sweeper._ends_clear`) --, and just after a
-traced edge was cut short by the death of a neighbour while its line still bounds a shadow (the edge goes
-on with another neighbour, a configuration that may live between two samples only:
-:meth:`Sweeper._continuation_gap`).  What this does not prove is listed in
+carry a shadow edge at some sample (:meth:`Sweeper._live_mids`; not in the first or last
+interval where the sample at the segment's end stands in, :meth:`Sweeper._ends_clear`) --,
+and just after a traced edge was cut short by the death of a neighbour while its line still
+bounds a shadow (the edge goes on with another neighbour, a configuration that may live
+between two samples only: :meth:`Sweeper._continuation_gap`).  What this does not prove is listed in
 docs/DESIGN.md.
 """
 
