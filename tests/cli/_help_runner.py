@@ -11,6 +11,7 @@ from __future__ import annotations
 import os
 import runpy
 import signal
+import subprocess
 import sys
 import tempfile
 import traceback
@@ -48,27 +49,37 @@ def _child(module: str, cwd: str, out: str, err: str) -> None:
 
 def run(modules: list[str]) -> dict[str, list]:
     """Per module: ``[exit status, stdout, stderr, names left in its working folder]``
-    (exit status negative: killed by that signal)."""
-    for lib in PRELOAD:
-        try:
-            __import__(lib)
-        except ImportError:
-            pass
+    (exit status negative: killed by that signal).  Without ``os.fork`` (not POSIX) each
+    module runs as its own ``python -m MODULE --help``."""
+    if hasattr(os, "fork"):
+        for lib in PRELOAD:
+            try:
+                __import__(lib)
+            except ImportError:
+                pass
     got = {}
     for module in modules:
-        io = tempfile.mkdtemp()
-        cwd = tempfile.mkdtemp()
-        out, err = os.path.join(io, "out"), os.path.join(io, "err")
-        sys.stdout.flush()
-        sys.stderr.flush()
-        pid = os.fork()
-        if pid == 0:
-            _child(module, cwd, out, err)
-        _, status = os.waitpid(pid, 0)
-        rc = os.waitstatus_to_exitcode(status)
-        texts = []
-        for path in (out, err):
-            with open(path, encoding="utf-8", errors="replace") as f:
-                texts.append(f.read())
-        got[module] = [rc, *texts, sorted(os.listdir(cwd))]
+        with tempfile.TemporaryDirectory() as io, tempfile.TemporaryDirectory() as cwd:
+            out, err = os.path.join(io, "out"), os.path.join(io, "err")
+            if hasattr(os, "fork"):
+                sys.stdout.flush()
+                sys.stderr.flush()
+                pid = os.fork()
+                if pid == 0:
+                    _child(module, cwd, out, err)
+                rc = os.waitstatus_to_exitcode(os.waitpid(pid, 0)[1])
+            else:
+                with open(out, "w") as fo, open(err, "w") as fe:
+                    cmd = [sys.executable, "-m", module, "--help"]
+                    try:
+                        rc = subprocess.run(
+                            cmd, cwd=cwd, stdout=fo, stderr=fe, timeout=TIMEOUT_S
+                        ).returncode
+                    except subprocess.TimeoutExpired:
+                        rc = -int(signal.SIGTERM)
+            texts = []
+            for path in (out, err):
+                with open(path, encoding="utf-8", errors="replace") as f:
+                    texts.append(f.read())
+            got[module] = [rc, *texts, sorted(os.listdir(cwd))]
     return got
