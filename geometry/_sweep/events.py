@@ -91,7 +91,8 @@ class CollinearityEvents:
         """Whether the samples at the ends of the segment ``q0 + t dq`` (t = 0, 1) stand in
         for the event samples of the first and last interval between its events ``ev_t``
         (:meth:`_events`; lazy rules only): no event of the motion's line (extended past the
-        segment) lies within half that interval's length before 0 (after 1), or at the end.
+        segment) that can open a wedge facing the segment lies within half that interval's
+        length before 0 (after 1), or at the end.
 
         Between consecutive events no wedge is born or dies (they are born and die at
         events), so a wedge alive in the first interval ``(0, t_1)`` is alive at 0 too, born
@@ -99,13 +100,23 @@ class CollinearityEvents:
         midpoint, the sample the interval takes otherwise (whose worst case is a wedge born
         at 0), and alive at least ``t_1`` after it.  The sample at 0 then holds it, and its
         edges are traced from there to its death as any edge of a sample.  The last interval
-        likewise, with the sample at 1 and the events after 1."""
+        likewise, with the sample at 1 and the events after 1.
+
+        Only events that can open a wedge on the side facing the segment count: before 0,
+        those whose wedge can be a shadow after them, and after 1 those whose wedge can be
+        one before them (:meth:`_wedge_sides`).  A wedge dies at an event where one would be
+        born with the sweep run backwards, and the sides are read from the geometry at the
+        event, whichever way the target runs: an event with no such side neither gives
+        birth to nor kills the wedge the end sample stands in for."""
         if not self.lazy_samples or len(ev_t) == 0:
             return (False, False)
         t1, tn = float(ev_t[0]), float(ev_t[-1])
-        before = self._event_window(q0, dq, -0.5 * t1, 2e-9)[0]
-        after = self._event_window(q0, dq, 1 - 2e-9, 1 + 0.5 * (1 - tn))[0]
-        return (len(before) == 0, len(after) == 0)
+        before = self._event_window(q0, dq, -0.5 * t1, 2e-9)[2]
+        after = self._event_window(q0, dq, 1 - 2e-9, 1 + 0.5 * (1 - tn))[2]
+        return (
+            not any(1 in side for sides in before for side in sides),
+            not any(-1 in side for sides in after for side in sides),
+        )
 
     def _events(self, q0: np.ndarray, dq: np.ndarray) -> tuple[np.ndarray, list, list]:
         """:meth:`_event_window` over the segment, times in (0, 1) (1e-9 off its ends)."""
@@ -282,6 +293,15 @@ class CollinearityEvents:
           x passes b_n (the corner nearer x) and b_f on opposite sides, so it is blocked
           only while it passes b_n on its obstacle's side, i.e. while x is on that side of
           the line: the side of the event where x is;
+        * first kind, an obstacle edge from a convex corner b_n (nearer x) to a concave one
+          b_f whose other edges lie on opposite sides of the line (a room's corner: the
+          obstacle lies along the edge on b_n's side, and beyond b_f the line runs into
+          it): a shadow can be born only along the edge, on its free side, between b_n and
+          b_f.  A point p there, with x on the free side of the line too, sees x along a
+          sight line that stays in that half-plane next to the line (b_n's other edge
+          lies on the obstacle's side, b_f's rises from b_f more steeply than the sight line
+          near the event), so it is blocked only while x is on the obstacle's side: the
+          side of the event where x is, as in the previous case;
         * otherwise (obstacles and the target on one side, not lone; the previous case in
           the 5.2 sweeps): either side."""
         out = np.zeros(len(k), dtype=int)
@@ -316,23 +336,32 @@ class CollinearityEvents:
         code = np.zeros(na, dtype=int)
         code[lone & (s0 == s1) & (s_t == -s0)] = _NEITHER
         # (corners of two obstacles, or not neighbours: a sight line crossing the line
-        # between the two ends of an obstacle edge crosses the edge)
+        # between the two ends of an obstacle edge crosses the edge; or an obstacle edge
+        # from a convex corner next to x to a concave one, a room's corner: see above)
         env = self.env
         c0, c1 = corners[:na, 0], corners[:na, 1]
         edge = (env.vert_next[c0] == env.vert[c1]).all(axis=1) | (
             env.vert_prev[c0] == env.vert[c1]
         ).all(axis=1)
+        near_i = np.abs(s_[ka, 0] - s_[ka, 2]) <= np.abs(s_[ka, 1] - s_[ka, 2])
+        room = self._room_edges(edge, np.where(near_i, c0, c1))
         # (not in the 5.2 sweeps: there the interval left whole across the event cost more
         # refinement samples than the side saved, measured on heidelberg_l1)
-        sel = lone & (s0 == -s1) & ~edge & (self.strips is None)
+        sel = lone & (s0 == -s1) & (~edge | room) & (self.strips is None)
         if sel.any():
             ks = ka[sel]
-            near_i = np.abs(s_[ks, 0] - s_[ks, 2]) <= np.abs(s_[ks, 1] - s_[ks, 2])
-            s_near = np.where(near_i, s0[sel], s1[sel])
+            s_near = np.where(near_i[sel], s0[sel], s1[sel])
             after = _side(lines[sel], vx[xa[ks]])
             code[sel] = np.where(after == 0, 0, np.where(after == s_near, 1, -1))
         out[np.searchsorted(k, ka)] = code
         return out
+
+    def _room_edges(self, edge: np.ndarray, near: np.ndarray) -> np.ndarray:
+        """Per row of :meth:`_wedge_sides`' first kind: is the line an obstacle edge
+        (``edge``) whose end nearer x (``near``) is a convex corner (a reflex vertex of the
+        free space)?  With the two ends' other edges on opposite sides of the line, its other
+        end is then a concave one: a room's corner.  (n,) bool."""
+        return edge & self.env.reflex[near]
 
     def _wanted_near(self, v: np.ndarray, q: np.ndarray, edge: bool = False) -> np.ndarray:
         """Per row, with the target at reference point ``q[r]``: is every point of its
