@@ -60,7 +60,7 @@ class CollinearityEvents:
                 return []
             looked.add((-1, 0))
             return sorted({float(t) for t in 0.5 * (bounds[1:] + bounds[:-1])} - set(frames))
-        keys = {frozenset(k) for _, es in frames.values() for e in es for k in e}
+        keys = self._frame_keys(frames)
         times = np.array(sorted(frames))
         out: set[float] = set()
         for k in range(len(ev_t)):
@@ -86,6 +86,21 @@ class CollinearityEvents:
                     continue
                 out.add(float(0.5 * (lo + hi)))
         return sorted(out)
+
+    def _frame_keys(self, frames: dict) -> set:
+        """The lines (frozensets of two anchor ids) of the shadow edges and their neighbours
+        at the samples ``frames`` (time -> (shadow, edges)), kept per dict and extended with
+        the samples added since the last call (a sample's edges do not change)."""
+        cache = self.__dict__.setdefault("_keys_of", {})
+        got = cache.get(id(frames))
+        if got is None or got[0] is not frames:
+            got = cache[id(frames)] = (frames, set(), set())
+        _, done, keys = got
+        for t, (_, es) in frames.items():
+            if t not in done:
+                done.add(t)
+                keys.update(frozenset(k) for e in es for k in e)
+        return keys
 
     def _ends_clear(self, q0: np.ndarray, dq: np.ndarray, ev_t: np.ndarray) -> tuple[bool, bool]:
         """Whether the samples at the ends of the segment ``q0 + t dq`` (t = 0, 1) stand in
