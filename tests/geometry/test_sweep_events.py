@@ -435,6 +435,24 @@ def test_events_with_the_target_between_their_corners_are_dropped(name, monkeypa
     _assert_close_with_fewer_samples(name, (lazy, made), (kept, made_kept))
 
 
+def _run_seeing_events(name: str, monkeypatch) -> tuple[dict, list, list]:
+    """:func:`_run` with the lazy rules, and every event the sweeps found: ``(sweeper, q0,
+    dq, t, (moving ids, other ids), sides)`` per anchor tuple of each event."""
+    ev = S.Sweeper._events
+    seen: list[tuple] = []
+
+    def spy(self, q0, dq):
+        ts, ids, sides = ev(self, q0, dq)
+        for t, evs, sds in zip(ts, ids, sides, strict=True):
+            seen.extend((self, q0, dq, t, a, sd) for a, sd in zip(evs, sds, strict=True))
+        return ts, ids, sides
+
+    with monkeypatch.context() as m:
+        m.setattr(S.Sweeper, "_events", spy)
+        got, made = _run(name, monkeypatch, lazy=True)
+    return got, made, seen
+
+
 def _sees(sw, p: np.ndarray, a: np.ndarray) -> bool:
     """Is the segment from ``p`` to ``a`` in the free space (closed)?"""
     return bool(shapely.covers(sw.free, shapely.LineString([p, a])))
@@ -453,18 +471,7 @@ def test_events_sample_only_the_sides_where_their_wedge_is_blind(name, monkeypat
     is wanted on both edges at each target anchor and between two of them; the regions
     (swept and 5.2) are those with both sides sampled (within the tolerance of
     :func:`_assert_close`), with fewer samples on ``willow_north``."""
-    ev = S.Sweeper._events
-    seen: list[tuple] = []
-
-    def spy(self, q0, dq):
-        ts, ids, sides = ev(self, q0, dq)
-        for t, evs, sds in zip(ts, ids, sides, strict=True):
-            seen.extend((self, q0, dq, t, a, sd) for a, sd in zip(evs, sds, strict=True))
-        return ts, ids, sides
-
-    with monkeypatch.context() as m:
-        m.setattr(S.Sweeper, "_events", spy)
-        got, made = _run(name, monkeypatch, lazy=True)
+    got, made, seen = _run_seeing_events(name, monkeypatch)
     checked = 0
     for sw, q0, dq, t, (mov, other), sides in seen:
         if sides == (-1, 1):
@@ -532,18 +539,7 @@ def test_a_room_corner_event_samples_only_the_side_where_x_is_behind_the_wall(
     halfway between the edge and the line from x through b_n: on the side not sampled p sees
     x, on the side sampled it is blind to x; and the regions (swept and 5.2) are those that
     sampling both sides of such events gives, with fewer samples on ``willow_south``."""
-    ev = S.Sweeper._events
-    seen: list[tuple] = []
-
-    def spy(self, q0, dq):
-        ts, ids, sides = ev(self, q0, dq)
-        for t, evs, sds in zip(ts, ids, sides, strict=True):
-            seen.extend((self, q0, dq, t, a, sd) for a, sd in zip(evs, sds, strict=True))
-        return ts, ids, sides
-
-    with monkeypatch.context() as m:
-        m.setattr(S.Sweeper, "_events", spy)
-        got, made = _run(name, monkeypatch, lazy=True)
+    got, made, seen = _run_seeing_events(name, monkeypatch)
     checked = 0
     for sw, q0, dq, t, (mov, other), sides in seen:
         env = sw.env
