@@ -117,17 +117,17 @@ class StationaryShadows:
         if not vs:
             return out
         # all rings labelled in one batch (row by row, so as if ring by ring)
-        d = np.concatenate([np.roll(v, -1, axis=0) - v for v in vs])
         flat = np.concatenate(vs)
         off = np.cumsum([0] + [len(v) for v in vs])
-        # an edge between two environment vertices far apart is on a fixed line (its key
-        # is two fixed anchors, see below): only the other edges and their neighbours are
-        # labelled (most of a shadow's boundary is the free space's)
-        fixed = self._fixed_edges(flat, off)
         ring_of = np.repeat(np.arange(len(vs)), np.diff(off))
         idx = np.arange(len(flat))
         nxt = np.where(idx + 1 == off[ring_of + 1], off[ring_of], idx + 1)
         prv = np.where(idx == off[ring_of], off[ring_of + 1] - 1, idx - 1)
+        d = flat[nxt] - flat  # each ring's edge vectors, closing edge included
+        # an edge between two environment vertices far apart is on a fixed line (its key
+        # is two fixed anchors, see below): only the other edges and their neighbours are
+        # labelled (most of a shadow's boundary is the free space's)
+        fixed = self._fixed_edges(flat, off)
         need = ~fixed | ~fixed[nxt] | ~fixed[prv]
         all_keys = np.full((len(flat), 2), -1, dtype=np.int64)
         if need.any():
