@@ -121,6 +121,24 @@ def _query(name: str, query: str) -> dict[str, shapely.Geometry]:
     return {"recognizable": recognizable_region(_scene(name), model="partial", **kw)}
 
 
+def _query_spying(name: str, query: str, method: str, monkeypatch) -> tuple[tuple, list]:
+    """:func:`_query` with the lazy rules (and its Sweepers, as :func:`_with_rule` gives
+    them), and every call of the segment method ``method`` of ``geometry.sweep._Run``:
+    ``(run, *args, result)`` each."""
+    calls: list[tuple] = []
+    orig = getattr(S._Run, method)
+
+    def spy(self, *args):
+        got = orig(self, *args)
+        calls.append((self, *args, got))
+        return got
+
+    with monkeypatch.context() as m:
+        m.setattr(S._Run, method, spy)
+        got = _with_rule(True, lambda: _query(name, query), monkeypatch)
+    return got, calls
+
+
 def _run(name: str, monkeypatch, lazy: bool) -> tuple[dict, list]:
     """The regions with lazy (or eager) sampling, and the Sweepers that made them."""
     return _with_rule(lazy, lambda: _queries(_scene(name)), monkeypatch)
@@ -745,20 +763,7 @@ def test_an_interval_whose_bound_lies_in_its_samples_shadows_takes_no_event_samp
     (:meth:`~geometry._sweep.births.BirthChecks._strips_miss`; on ``willow_north`` G and H are
     apart).  Without the rule the regions are within the bounds of the other lazy rules
     (:func:`_assert_close`) and take more samples."""
-    asked: list[tuple] = []
-    orig = S._Run.closes
-
-    def spy(self, a, b):
-        got = orig(self, a, b)
-        asked.append((self, a, b, got))
-        return got
-
-    def run():
-        return _query(name, query)
-
-    with monkeypatch.context() as m:
-        m.setattr(S._Run, "closes", spy)
-        got = _with_rule(True, run, monkeypatch)
+    got, asked = _query_spying(name, query, "closes", monkeypatch)
     closed = {(id(r), a, b): (r, a, b) for r, a, b, ok in asked if ok}
     assert closed
     for r, a, b in closed.values():
@@ -771,7 +776,7 @@ def test_an_interval_whose_bound_lies_in_its_samples_shadows_takes_no_event_samp
             assert not wide.any(), (name, a, b, t)
     with monkeypatch.context() as m:
         m.setattr(B.BirthChecks, "_closes", lambda self, *a: False)
-        ref = _with_rule(True, run, monkeypatch)
+        ref = _with_rule(True, lambda: _query(name, query), monkeypatch)
     _assert_close(name, got[0], ref[0])
     n_got, n_ref = (sum(len(sw._frames) for sw in made) for _, made in (got, ref))
     assert n_got < n_ref
@@ -801,7 +806,7 @@ def test_an_interval_holding_a_wedge_stays_open(name, query, monkeypatch) -> Non
     got = _with_rule(True, run, monkeypatch)
     with monkeypatch.context() as m:
         m.setattr(B.BirthChecks, "_closes", lambda self, *a: False)
-        ref = _with_rule(True, run, monkeypatch)
+        ref = _with_rule(True, lambda: _query(name, query), monkeypatch)
     _assert_close(name, got[0], ref[0])
 
 
@@ -875,20 +880,7 @@ def test_the_end_samples_stand_in_for_the_first_and_last_event_interval(
     with a wider window of :meth:`_event_window`); on ``willow_south`` one end stands in
     with an event there whose wedge can be a shadow on neither side (the line of two target
     vertices through a corner)."""
-    clear: list[tuple] = []
-    orig = S._Run.ends_clear
-
-    def spy(self, end):
-        got = orig(self, end)
-        clear.append((self, end, got))
-        return got
-
-    def run():
-        return _query(name, query)
-
-    with monkeypatch.context() as m:
-        m.setattr(S._Run, "ends_clear", spy)
-        got = _with_rule(True, run, monkeypatch)
+    got, clear = _query_spying(name, query, "ends_clear", monkeypatch)
     sideless = 0  # ends that stand in with an event in the window that opens no wedge
     for r, end, ok in clear:
         if not ok:
@@ -910,7 +902,7 @@ def test_the_end_samples_stand_in_for_the_first_and_last_event_interval(
         assert sideless  # the side filter is exercised
     with monkeypatch.context() as m:
         m.setattr(E.CollinearityEvents, "_ends_clear", lambda self, *a: (False, False))
-        ref = _with_rule(True, run, monkeypatch)
+        ref = _with_rule(True, lambda: _query(name, query), monkeypatch)
     _assert_close(name, got[0], ref[0])
     n_got, n_ref = (sum(len(sw._frames) for sw in made) for _, made in (got, ref))
     assert n_got <= n_ref
