@@ -317,8 +317,7 @@ class CollinearityEvents:
           lies on the obstacle's side, b_f's rises from b_f more steeply than the sight line
           near the event), so it is blocked only while x is on the obstacle's side: the
           side of the event where x is, as in the previous case;
-        * otherwise (obstacles and the target on one side, not lone; the previous case in
-          the 5.2 sweeps): either side."""
+        * otherwise (obstacles and the target on one side, not lone): either side."""
         out = np.zeros(len(k), dtype=int)
         ka, kb = k[k < n_a], k[k >= n_a]
         ka = ka[(xa[ka] < self.m) & (fix[la[ka]] >= 0).all(axis=1)]
@@ -360,9 +359,7 @@ class CollinearityEvents:
         ).all(axis=1)
         near_i = np.abs(s_[ka, 0] - s_[ka, 2]) <= np.abs(s_[ka, 1] - s_[ka, 2])
         room = self._room_edges(edge, np.where(near_i, c0, c1))
-        # (not in the 5.2 sweeps: there the interval left whole across the event cost more
-        # refinement samples than the side saved, measured on heidelberg_l1)
-        sel = lone & (s0 == -s1) & (~edge | room) & (self.strips is None)
+        sel = lone & (s0 == -s1) & (~edge | room)
         if sel.any():
             ks = ka[sel]
             s_near = np.where(near_i[sel], s0[sel], s1[sel])

@@ -490,10 +490,11 @@ def test_events_sample_only_the_sides_where_their_wedge_is_blind(name, monkeypat
     (swept and 5.2) are those with both sides sampled (within the tolerance of
     :func:`_assert_close`), with fewer samples on ``willow_north``."""
     got, made, seen = _run_seeing_events(name, monkeypatch)
-    checked = 0
+    checked = one_sided_52 = 0
     for sw, q0, dq, t, (mov, other), sides in seen:
         if sides == (-1, 1):
             continue
+        one_sided_52 += sw.strips is not None and len(sides) == 1
         if sw.strips is not None:  # what the wedge's sight lines reach is wanted
             _, wanted, ids = sw.outline(q0 + t * dq)
             at = [int(np.flatnonzero(ids == a)[0]) for a in mov]
@@ -532,6 +533,8 @@ def test_events_sample_only_the_sides_where_their_wedge_is_blind(name, monkeypat
             checked += 1
     if name != "real/willow_south":
         assert checked  # not vacuous
+    if name == "real/willow_north":
+        assert one_sided_52  # case (iii) in a 5.2 sweep
     orig = E.CollinearityEvents._wedge_sides
 
     def both(self, k, *a):
@@ -558,7 +561,7 @@ def test_a_room_corner_event_samples_only_the_side_where_x_is_behind_the_wall(
     x, on the side sampled it is blind to x; and the regions (swept and 5.2) are those that
     sampling both sides of such events gives, with fewer samples on ``willow_south``."""
     got, made, seen = _run_seeing_events(name, monkeypatch)
-    checked = 0
+    checked = checked_52 = 0
     for sw, q0, dq, t, (mov, other), sides in seen:
         env = sw.env
         if len(mov) != 1 or len(other) != 2 or len(sides) != 1 or min(other) < 0:
@@ -586,7 +589,10 @@ def test_a_room_corner_event_samples_only_the_side_where_x_is_behind_the_wall(
             blind = not _sees(sw, p, x)
             assert blind == (sign in sides), (name, t, mov, other, sides, sign)
             checked += 1
+            checked_52 += sw.strips is not None
     assert checked  # not vacuous
+    if name == "real/willow_south":
+        assert checked_52  # in a 5.2 sweep too
     with monkeypatch.context() as m:
         m.setattr(
             E.CollinearityEvents, "_room_edges", lambda self, edge, near: np.zeros(len(edge), bool)
