@@ -15,6 +15,12 @@ import shapely
 from .._shapes import cross as _cross
 from .lines import _corner_pairs
 
+#: The window of a segment's line (times, the segment being (0, 1)) whose events
+#: :meth:`CollinearityEvents._event_window` computes once per segment and filters for every
+#: window inside it: the segment's, and the half intervals past its ends (at most half the
+#: segment) that :meth:`CollinearityEvents._ends_clear` looks at.
+ROWS_WINDOW = (-0.5, 1.5)
+
 
 class CollinearityEvents:
     """The collinearity events of a :class:`~geometry.sweep.Sweeper` (a mixin of it: it
@@ -160,7 +166,41 @@ class CollinearityEvents:
         looks for shadow components apart from the known ones, does not see it: fuzz
         issue 26.3/26.4).  Sampling once between consecutive events catches such a
         shadow at a time it has area, and its edges are then traced both ways (next to
-        the events :meth:`_live_mids` finds live)."""
+        the events :meth:`_live_mids` finds live).
+
+        The events of a segment are computed once, over the window :data:`ROWS_WINDOW` of
+        its line (:meth:`_event_rows`), and each window inside it (the segment's, and the
+        half intervals past its ends that :meth:`_ends_clear` looks at) takes its rows from
+        them: every test of an event is row by row, so the rows of a window are the same,
+        bit for bit, as if it were computed alone (a window outside it is)."""
+        if ROWS_WINDOW[0] <= lo and hi <= ROWS_WINDOW[1]:
+            key = (q0.tobytes(), dq.tobytes())
+            cache = self.__dict__.setdefault("_ev_rows", {})
+            rows = cache.get(key)
+            if rows is None:
+                rows = cache[key] = self._event_rows(q0, dq, *ROWS_WINDOW)
+        else:
+            rows = self._event_rows(q0, dq, lo, hi)
+        t, ids, side, keep = rows
+        kept = np.flatnonzero(keep & (t > lo) & (t < hi))
+        kept = kept[np.argsort(t[kept], kind="stable")]
+        ts = t[kept]
+        # merge events closer than the tracing can tell apart (the first time stands)
+        first = np.concatenate([[True], np.diff(ts) > 1e-9]) if len(ts) else np.zeros(0, bool)
+        group = np.cumsum(first) - 1
+        out: list[list] = [[] for _ in range(int(first.sum()))]
+        sides: list[list] = [[] for _ in out]
+        for g, c in zip(group, kept, strict=True):
+            out[g].append(ids[c])
+            sides[g].append(_SIDES[int(side[c])])
+        return ts[first], out, sides
+
+    def _event_rows(
+        self, q0: np.ndarray, dq: np.ndarray, lo: float, hi: float
+    ) -> tuple[np.ndarray, list, np.ndarray, np.ndarray]:
+        """Every candidate event of :meth:`_event_window` in the window ``(lo, hi)``, one row
+        each, unsorted: its time, its anchor ids, the sides of it where its wedge can be a
+        shadow (a code of ``_SIDES``) and whether it counts (tangent, unobstructed, ...)."""
         b, i, j = self._event_lines()
         env = self.env
         # obstacle edges with a convex end (a beam can graze along them past that end)
@@ -214,7 +254,7 @@ class CollinearityEvents:
         spans = np.concatenate([seg_a, np.stack([bb, np.where(first, ak, ai)], axis=1)])
         t = np.concatenate([ta, tb])
         if len(t) == 0:
-            return t, [], []
+            return t, [], np.zeros(0, dtype=int), np.zeros(0, dtype=bool)
         keep = self._tangent_events(xa, ta, la, w, lb, pb, b, ii, kk)
         if self.lazy_samples:  # (the previous rules keep them)
             keep[: len(ta)] &= ~_between(s_, la < len(i), self.tol_lab)
@@ -260,18 +300,7 @@ class CollinearityEvents:
             side[k] = self._wedge_sides(
                 k, len(ta), xa, la, w, s_, vx, spans, fix, pb, lb, cvx, ii, kk, q0 + t[:, None] * dq
             )
-        kept = np.flatnonzero(keep)
-        kept = kept[np.argsort(t[kept], kind="stable")]
-        ts = t[kept]
-        # merge events closer than the tracing can tell apart (the first time stands)
-        first = np.concatenate([[True], np.diff(ts) > 1e-9]) if len(ts) else np.zeros(0, bool)
-        group = np.cumsum(first) - 1
-        out: list[list] = [[] for _ in range(int(first.sum()))]
-        sides: list[list] = [[] for _ in out]
-        for g, c in zip(group, kept, strict=True):
-            out[g].append(ids[c])
-            sides[g].append(_SIDES[int(side[c])])
-        return ts[first], out, sides
+        return t, ids, side, keep
 
     def _wedge_sides(
         self, k, n_a, xa, la, w, s_, vx, spans, fix, pb, lb, cvx, ii, kk, qe

@@ -420,11 +420,13 @@ def test_events_with_the_target_between_their_corners_are_dropped(name, monkeypa
 
     def spy(self, q0, dq):
         ts, ids, sides = ev(self, q0, dq)
+        rows = self.__dict__.pop("_ev_rows", None)  # the events kept per segment
         with monkeypatch.context() as m:  # the same sweeper keeping them
             m.setattr(E, "_between", lambda s_, pair, tol: np.zeros(len(s_), dtype=bool))
             for attr in ("_ev_lines", "_ev_corners"):
                 self.__dict__.pop(attr, None)
             all_ts, all_ids, _ = ev(self, q0, dq)
+        self.__dict__["_ev_rows"] = rows or {}
         kept = {(round(float(t), 12), tuple(map(tuple, i))) for t, i in zip(ts, ids, strict=True)}
         for t, evs in zip(all_ts, all_ids, strict=True):
             for mov, other in evs:
@@ -915,3 +917,29 @@ def test_the_end_samples_stand_in_for_the_first_and_last_event_interval(
     if name.startswith("real/"):
         assert any(ok for _, _, ok in clear)
         assert n_got < n_ref
+
+
+@pytest.mark.parametrize(
+    ("name", "query"), [("real/willow_south", "swept"), ("real/willow_north", "recognizable")]
+)
+def test_a_window_of_the_kept_event_rows_is_the_window_computed_alone(
+    name, query, monkeypatch
+) -> None:
+    """:meth:`~geometry._sweep.events.CollinearityEvents._event_window` takes a window inside
+    ``ROWS_WINDOW`` from the rows it computed once for the segment: the times, anchors and
+    sides are those of the window computed on its own (the segment's, and windows past its
+    ends as :meth:`_ends_clear` asks), on every segment of the query's sweeps."""
+    (_, made), clear = _query_spying(name, query, "ends_clear", monkeypatch)
+    runs = {id(r): r for r, *_ in clear}.values()
+    assert runs  # not vacuous
+    checked = 0
+    for r in runs:
+        assert r.sw.__dict__.get("_ev_rows")  # the rows were kept
+        for lo, hi in ((1e-9, 1 - 1e-9), (-0.4, 2e-9), (1 - 2e-9, 1.3), (0.2, 0.7)):
+            got = r.sw._event_window(r.q0, r.dq, lo, hi)
+            with monkeypatch.context() as m:
+                m.setattr(E, "ROWS_WINDOW", (0.0, 0.0))  # every window computed alone
+                alone = r.sw._event_window(r.q0, r.dq, lo, hi)
+            assert np.array_equal(got[0], alone[0]) and got[1:] == alone[1:], (name, lo, hi)
+            checked += len(got[0])
+    assert checked
