@@ -149,7 +149,9 @@ class _Run:
     frames: dict[float, tuple] = field(default_factory=dict)
     looked: set[tuple[int, int]] = field(default_factory=set)
     stats: dict[str, int] = field(default_factory=lambda: {"samples": 0, "edges": 0, "refined": 0})
-    ev_t: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    #: its events (:meth:`Sweeper._events`: times, anchors, sides); None until one may be
+    #: live (:meth:`live_mids`)
+    ev_t: np.ndarray | None = None
     ev_ids: list = field(default_factory=list)
     ev_side: list = field(default_factory=list)
     #: whether the samples at 0 and 1 stand in for the first and last interval's event
@@ -173,6 +175,16 @@ class _Run:
             upper = self.bounds.get((a, b))
             got = self.closed[(a, b)] = upper is not None and self.sw._closes(self, a, b, upper)
         return got
+
+    def live_mids(self) -> list[float]:
+        """The event samples :meth:`Sweeper._live_mids` asks for now.  The events are
+        computed the first time one of them may be live (:meth:`Sweeper._may_be_live`):
+        until then no event is, and nothing is asked for."""
+        if self.ev_t is None:
+            if not self.sw._may_be_live(self.q0, self.dq, self.frames):
+                return []
+            self.ev_t, self.ev_ids, self.ev_side = self.sw._events(self.q0, self.dq)
+        return self.sw._live_mids(*self.event_args())
 
     def event_args(self) -> tuple:
         """The arguments of :meth:`Sweeper._live_mids` for this segment."""
@@ -430,12 +442,11 @@ class Sweeper(StationaryShadows, PointTest, CollinearityEvents, Coverage, BirthC
         # the collinearity events (shadows born on a line) are sampled lazily: once
         # between consecutive events next to a *live* event, one whose wedge's lines carry
         # a shadow edge at a sample so far (see _live_mids), until no new one is live;
-        # first from the samples alone, then again after the refinements of the tracing
+        # first from the samples alone, then again after the refinements of the tracing (a
+        # segment computes its events once one may be live: _Run.live_mids)
         with clock("event samples"):
-            for r in moving:
-                r.ev_t, r.ev_ids, r.ev_side = self._events(r.q0, r.dq)
             while True:
-                asked = [(r, self._live_mids(*r.event_args())) for r in moving]
+                asked = [(r, r.live_mids()) for r in moving]
                 asked = [(r, mids) for r, mids in asked if mids]
                 if not asked:
                     break
@@ -469,7 +480,7 @@ class Sweeper(StationaryShadows, PointTest, CollinearityEvents, Coverage, BirthC
         while True:
             self._sweep_intervals(todo, q0, q1, frame, pieces, state, stats, pre)
             pre = None
-            mids = self._live_mids(*run.event_args())
+            mids = run.live_mids()
             if not mids:
                 return pieces
             self._prefetch([q0 + t * dq for t in mids])

@@ -8,6 +8,7 @@ segment continuing a known shadow edge.  Part of :class:`geometry.sweep.Sweeper`
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import NamedTuple
 
 import numpy as np
 import shapely
@@ -20,6 +21,37 @@ from .lines import _corner_pairs
 #: window inside it: the segment's, and the half intervals past its ends (at most half the
 #: segment) that :meth:`CollinearityEvents._ends_clear` looks at.
 ROWS_WINDOW = (-0.5, 1.5)
+
+
+class _Times(NamedTuple):
+    """The geometric candidates of a segment's events (:meth:`CollinearityEvents._event_times`):
+    the event lines ``p0 + s w`` (``p1 = p0 + w``), the moving anchors at t = 0 (``x0``) and
+    their velocities (``vx``), their ids (``mov_id``; ``ok``: which ends of wanted pieces
+    move with a finite position), the pairs (``ii``, ``kk``) of target vertices and the
+    target's vertices at t = 0 (``a0``); the crossings of a moving anchor ``xa`` with line
+    ``la`` at ``ta`` and of the line of the vertex pair ``pb`` with corner ``lb`` at ``tb``."""
+
+    p0: np.ndarray
+    p1: np.ndarray
+    w: np.ndarray
+    x0: np.ndarray
+    vx: np.ndarray
+    ii: np.ndarray
+    kk: np.ndarray
+    a0: np.ndarray
+    ok: np.ndarray
+    mov_id: np.ndarray
+    la: np.ndarray
+    xa: np.ndarray
+    ta: np.ndarray
+    lb: np.ndarray
+    pb: np.ndarray
+    tb: np.ndarray
+
+
+#: An unordered pair of anchor ids ``a < b`` as one integer, ``a * _PAIR + b``
+#: (:meth:`CollinearityEvents._may_be_live`; ids are below it).
+_PAIR = 1 << 31
 
 
 class CollinearityEvents:
@@ -97,16 +129,23 @@ class CollinearityEvents:
         """The lines (frozensets of two anchor ids) of the shadow edges and their neighbours
         at the samples ``frames`` (time -> (shadow, edges)), kept per dict and extended with
         the samples added since the last call (a sample's edges do not change)."""
+        return self._frame_lines(frames)[0]
+
+    def _frame_lines(self, frames: dict) -> tuple[set, set]:
+        """:meth:`_frame_keys`, and the same lines of two distinct anchors as integers
+        (``a * _PAIR + b``, ``a < b``)."""
         cache = self.__dict__.setdefault("_keys_of", {})
         got = cache.get(id(frames))
         if got is None or got[0] is not frames:
-            got = cache[id(frames)] = (frames, set(), set())
-        _, done, keys = got
+            got = cache[id(frames)] = (frames, set(), set(), set())
+        _, done, keys, codes = got
         for t, (_, es) in frames.items():
             if t not in done:
                 done.add(t)
-                keys.update(frozenset(k) for e in es for k in e)
-        return keys
+                new = {frozenset(k) for e in es for k in e}
+                keys.update(new)
+                codes.update(min(k) * _PAIR + max(k) for k in new if len(k) == 2)
+        return keys, codes
 
     def _ends_clear(self, q0: np.ndarray, dq: np.ndarray, ev_t: np.ndarray) -> tuple[bool, bool]:
         """Whether the samples at the ends of the segment ``q0 + t dq`` (t = 0, 1) stand in
@@ -201,38 +240,13 @@ class CollinearityEvents:
         """Every candidate event of :meth:`_event_window` in the window ``(lo, hi)``, one row
         each, unsorted: its time, its anchor ids, the sides of it where its wedge can be a
         shadow (a code of ``_SIDES``) and whether it counts (tangent, unobstructed, ...)."""
-        b, i, j = self._event_lines()
-        env = self.env
-        # obstacle edges with a convex end (a beam can graze along them past that end)
+        b, i, _ = self._event_lines()
         cvx = self._event_corners()
-        p0 = np.vstack([b[i], env.vert[cvx], env.vert[cvx]])
-        p1 = np.vstack([b[j], env.vert_next[cvx], env.vert_prev[cvx]])
-        w = p1 - p0
-        # moving anchors at t = 0 and their velocities (target vertices: dq; ends of the
-        # wanted pieces slide along their strip segment)
-        q0v = q0[None, :]
-        mov0 = [self.ring0 + q0v]
-        vel = [np.broadcast_to(dq, self.ring0.shape)]
-        if len(self._cut_segs):
-            ids = self.n_fixed + self.m + np.arange(len(self._cut_segs))
-            with np.errstate(invalid="ignore"):  # an edge parallel to its strip segment
-                c0 = self.pos(ids, np.repeat(q0v, len(ids), 0))
-                c1 = self.pos(ids, np.repeat((q0 + dq)[None, :], len(ids), 0))
-            ok = np.isfinite(c0).all(axis=1) & np.isfinite(c1).all(axis=1)
-            mov0.append(c0[ok])
-            vel.append(c1[ok] - c0[ok])
-        x0, vx = np.vstack(mov0), np.vstack(vel)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            # x0 + t vx on the line (p0, w)
-            ta = _cross(w[:, None, :], p0[:, None, :] - x0[None]) / _cross(w[:, None, :], vx[None])
-            ii, kk = np.triu_indices(self.m, 1)
-            wt = self.ring0[kk] - self.ring0[ii]
-            a0 = self.ring0 + q0v
-            tb = _cross(wt[None], b[:, None, :] - a0[ii][None]) / _cross(wt, dq)[None]
-        la, xa = np.nonzero(np.isfinite(ta) & (ta > lo) & (ta < hi))
-        ta = ta[la, xa]
-        lb, pb = np.nonzero(np.isfinite(tb) & (tb > lo) & (tb < hi))
-        tb = tb[lb, pb]
+        ev = self._times_kept(q0, dq) if (lo, hi) == ROWS_WINDOW else None
+        if ev is None:
+            ev = self._event_times(q0, dq, lo, hi)
+        p0, p1, w, x0, vx, ii, kk, a0 = ev.p0, ev.p1, ev.w, ev.x0, ev.vx, ev.ii, ev.kk, ev.a0
+        la, xa, ta, lb, pb, tb = ev.la, ev.xa, ev.ta, ev.lb, ev.pb, ev.tb
         # unobstructed: the line's piece spanning its three points lies in the free space
         xs = x0[xa] + ta[:, None] * vx[xa]
         pts = np.stack([p0[la], p1[la], xs], axis=1)  # (A, 3, 2)
@@ -262,8 +276,7 @@ class CollinearityEvents:
         keep[idx] = shapely.covers(self._free_near(), shapely.linestrings(segs[idx]))
         cut = np.flatnonzero(xa >= self.m)  # ends of wanted pieces: on their edge then?
         if len(cut):
-            k = xa[cut] - self.m
-            kk_ = np.flatnonzero(np.isfinite(c0).all(axis=1) & np.isfinite(c1).all(axis=1))[k]
+            kk_ = np.flatnonzero(ev.ok)[xa[cut] - self.m]
             i_e = self._cut_edge[kk_]
             a_e = self.ring0[i_e] + q0 + ta[cut, None] * dq
             e_e = self.edge0[i_e]
@@ -278,17 +291,7 @@ class CollinearityEvents:
         # the anchor ids of each event: the moving ones and the others (lines through two
         # of them carry the edges of the wedge that opens there, see _live_mids)
         n = self.n_fixed
-        mov_id = n + np.arange(self.m)
-        if len(self._cut_segs):
-            mov_id = np.concatenate([mov_id, n + self.m + np.flatnonzero(ok)])
-        nxt, prv = self._ring_neighbours()
-        fix = np.vstack(
-            [
-                np.stack([cvx[i], cvx[j]], axis=1),
-                np.stack([cvx, nxt[cvx]], axis=1),
-                np.stack([cvx, prv[cvx]], axis=1),
-            ]
-        )
+        mov_id, fix = ev.mov_id, self._event_fixed()
         ids = [((int(mov_id[x]),), tuple(fix[k].tolist())) for x, k in zip(xa, la, strict=True)]
         ids += [
             ((n + int(ii[p]), n + int(kk[p])), (int(cvx[k]),)) for p, k in zip(pb, lb, strict=True)
@@ -301,6 +304,118 @@ class CollinearityEvents:
                 k, len(ta), xa, la, w, s_, vx, spans, fix, pb, lb, cvx, ii, kk, q0 + t[:, None] * dq
             )
         return t, ids, side, keep
+
+    def _event_times(self, q0: np.ndarray, dq: np.ndarray, lo: float, hi: float) -> _Times:
+        """The times in ``(lo, hi)`` at which a moving anchor crosses an event line, or the
+        line of two target vertices crosses a convex corner: the geometric candidates of
+        :meth:`_event_rows`, before any test of them (:class:`_Times`)."""
+        b, i, j = self._event_lines()
+        env = self.env
+        # obstacle edges with a convex end (a beam can graze along them past that end)
+        cvx = self._event_corners()
+        p0 = np.vstack([b[i], env.vert[cvx], env.vert[cvx]])
+        p1 = np.vstack([b[j], env.vert_next[cvx], env.vert_prev[cvx]])
+        w = p1 - p0
+        # moving anchors at t = 0 and their velocities (target vertices: dq; ends of the
+        # wanted pieces slide along their strip segment)
+        q0v = q0[None, :]
+        mov0 = [self.ring0 + q0v]
+        vel = [np.broadcast_to(dq, self.ring0.shape)]
+        mov_id = self.n_fixed + np.arange(self.m)
+        ok = np.zeros(0, dtype=bool)
+        if len(self._cut_segs):
+            ids = self.n_fixed + self.m + np.arange(len(self._cut_segs))
+            with np.errstate(invalid="ignore"):  # an edge parallel to its strip segment
+                c0 = self.pos(ids, np.repeat(q0v, len(ids), 0))
+                c1 = self.pos(ids, np.repeat((q0 + dq)[None, :], len(ids), 0))
+            ok = np.isfinite(c0).all(axis=1) & np.isfinite(c1).all(axis=1)
+            mov0.append(c0[ok])
+            vel.append(c1[ok] - c0[ok])
+            mov_id = np.concatenate([mov_id, ids[ok]])
+        x0, vx = np.vstack(mov0), np.vstack(vel)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            # x0 + t vx on the line (p0, w)
+            ta = _cross(w[:, None, :], p0[:, None, :] - x0[None]) / _cross(w[:, None, :], vx[None])
+            ii, kk = np.triu_indices(self.m, 1)
+            wt = self.ring0[kk] - self.ring0[ii]
+            a0 = self.ring0 + q0v
+            tb = _cross(wt[None], b[:, None, :] - a0[ii][None]) / _cross(wt, dq)[None]
+        la, xa = np.nonzero(np.isfinite(ta) & (ta > lo) & (ta < hi))
+        lb, pb = np.nonzero(np.isfinite(tb) & (tb > lo) & (tb < hi))
+        return _Times(
+            p0, p1, w, x0, vx, ii, kk, a0, ok, mov_id, la, xa, ta[la, xa], lb, pb, tb[lb, pb]
+        )
+
+    def _times_kept(self, q0: np.ndarray, dq: np.ndarray) -> _Times | None:
+        """:meth:`_event_times` over :data:`ROWS_WINDOW` of the segment, computed once for it
+        (:meth:`_may_be_live` and :meth:`_event_rows` both start from them); None where that
+        window does not hold the segment's own (0, 1)."""
+        lo, hi = ROWS_WINDOW
+        if not (lo <= 1e-9 and 1 - 1e-9 <= hi):
+            return None
+        key = (q0.tobytes(), dq.tobytes(), lo, hi)
+        cache = self.__dict__.setdefault("_ev_times", {})
+        got = cache.get(key)
+        if got is None:
+            got = cache[key] = self._event_times(q0, dq, lo, hi)
+        return got
+
+    def _event_fixed(self) -> np.ndarray:
+        """(lines, 2) the two environment vertices of each event line of
+        :meth:`_event_times` (``p0``'s rows): two corners, or a convex corner and its next
+        or previous vertex along its ring (-1 where not known), cached."""
+        got = getattr(self, "_ev_fixed", None)
+        if got is None:
+            _, i, j = self._event_lines()
+            cvx = self._event_corners()
+            nxt, prv = self._ring_neighbours()
+            got = self._ev_fixed = np.vstack(
+                [
+                    np.stack([cvx[i], cvx[j]], axis=1),
+                    np.stack([cvx, nxt[cvx]], axis=1),
+                    np.stack([cvx, prv[cvx]], axis=1),
+                ]
+            )
+        return got
+
+    def _may_be_live(self, q0: np.ndarray, dq: np.ndarray, frames: dict) -> bool:
+        """Whether :meth:`_live_mids` can find an event of the segment ``q0 + t dq`` live
+        with the samples ``frames``: some candidate event of :meth:`_events`' window (before
+        the tests that decide whether it counts, and its sides) has an unknown anchor (-1) or
+        two anchors, one of them moving, whose line carries a shadow edge or a neighbour of
+        one at a sample (:meth:`_frame_keys`), which is what makes an event live.  When
+        none has, no event is live and :meth:`_live_mids` asks for nothing, whatever the
+        tests would decide: the events need not be computed (yet).  The candidates' anchor
+        pairs are kept per segment."""
+        key = (q0.tobytes(), dq.tobytes())
+        cache = self.__dict__.setdefault("_ev_pairs", {})
+        got = cache.get(key)
+        if got is None:
+            ev = self._times_kept(q0, dq)
+            if ev is None:
+                ev = self._event_times(q0, dq, 1e-9, 1 - 1e-9)
+            a = (ev.ta > 1e-9) & (ev.ta < 1 - 1e-9)
+            b = (ev.tb > 1e-9) & (ev.tb < 1 - 1e-9)
+            fix = self._event_fixed()[ev.la[a]]
+            m = ev.mov_id[ev.xa[a]]
+            n = self.n_fixed
+            pb, lb = ev.pb[b], ev.lb[b]
+            x1, x2, c = n + ev.ii[pb], n + ev.kk[pb], self._event_corners()[lb]
+            pairs = np.concatenate(
+                [
+                    np.stack([m, fix[:, 0]], axis=1),
+                    np.stack([m, fix[:, 1]], axis=1),
+                    np.stack([x1, x2], axis=1),
+                    np.stack([x1, c], axis=1),
+                    np.stack([x2, c], axis=1),
+                ]
+            ).astype(np.int64)
+            lo, hi = np.sort(pairs, axis=1).T
+            got = cache[key] = (bool((fix < 0).any()), set((lo * _PAIR + hi).tolist()))
+        unknown, codes = got
+        if unknown:
+            return True
+        return not codes.isdisjoint(self._frame_lines(frames)[1])
 
     def _wedge_sides(
         self, k, n_a, xa, la, w, s_, vx, spans, fix, pb, lb, cvx, ii, kk, qe
