@@ -56,8 +56,9 @@ _PAIR = 1 << 31
 
 class CollinearityEvents:
     """The collinearity events of a :class:`~geometry.sweep.Sweeper` (a mixin of it: it
-    uses the sweeper's scene, target and anchors): :meth:`_events` along a segment and
-    the samples :meth:`_live_mids` asks for next to them."""
+    uses the sweeper's scene, target and anchors): :meth:`_events` along a segment,
+    whether one of them may be live before they are computed (:meth:`_may_be_live`) and the
+    samples :meth:`_live_mids` asks for next to them."""
 
     def _live_mids(
         self,
