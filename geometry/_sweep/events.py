@@ -214,11 +214,9 @@ class CollinearityEvents:
         them: every test of an event is row by row, so the rows of a window are the same,
         bit for bit, as if it were computed alone (a window outside it is)."""
         if ROWS_WINDOW[0] <= lo and hi <= ROWS_WINDOW[1]:
-            key = (q0.tobytes(), dq.tobytes())
-            cache = self.__dict__.setdefault("_ev_rows", {})
-            rows = cache.get(key)
-            if rows is None:
-                rows = cache[key] = self._event_rows(q0, dq, *ROWS_WINDOW)
+            rows = self._per_segment(
+                "_ev_rows", q0, dq, lambda: self._event_rows(q0, dq, *ROWS_WINDOW)
+            )
         else:
             rows = self._event_rows(q0, dq, lo, hi)
         t, ids, side, keep = rows
@@ -354,11 +352,26 @@ class CollinearityEvents:
         lo, hi = ROWS_WINDOW
         if not (lo <= 1e-9 and 1 - 1e-9 <= hi):
             return None
-        key = (q0.tobytes(), dq.tobytes(), lo, hi)
-        cache = self.__dict__.setdefault("_ev_times", {})
+        return self._per_segment(
+            "_ev_times", q0, dq, lambda: self._event_times(q0, dq, lo, hi), (lo, hi)
+        )
+
+    def _per_segment(
+        self,
+        name: str,
+        q0: np.ndarray,
+        dq: np.ndarray,
+        make: Callable[[], object],
+        extra: tuple = (),
+    ) -> object:
+        """``make()``, computed once per segment ``q0 + t dq`` (and ``extra``) and kept in the
+        sweeper's dict ``name``: what it keeps depends only on the segment and the sweeper's
+        fixed state (lines, corners, strips, rules)."""
+        cache = self.__dict__.setdefault(name, {})
+        key = (q0.tobytes(), dq.tobytes(), *extra)
         got = cache.get(key)
         if got is None:
-            got = cache[key] = self._event_times(q0, dq, lo, hi)
+            got = cache[key] = make()
         return got
 
     def _event_fixed(self) -> np.ndarray:
@@ -387,36 +400,40 @@ class CollinearityEvents:
         one at a sample (:meth:`_frame_keys`), which is what makes an event live.  When
         none has, no event is live and :meth:`_live_mids` asks for nothing, whatever the
         tests would decide: the events need not be computed (yet).  The candidates' anchor
-        pairs are kept per segment."""
-        key = (q0.tobytes(), dq.tobytes())
-        cache = self.__dict__.setdefault("_ev_pairs", {})
-        got = cache.get(key)
-        if got is None:
-            ev = self._times_kept(q0, dq)
-            if ev is None:
-                ev = self._event_times(q0, dq, 1e-9, 1 - 1e-9)
-            a = (ev.ta > 1e-9) & (ev.ta < 1 - 1e-9)
-            b = (ev.tb > 1e-9) & (ev.tb < 1 - 1e-9)
-            fix = self._event_fixed()[ev.la[a]]
-            m = ev.mov_id[ev.xa[a]]
-            n = self.n_fixed
-            pb, lb = ev.pb[b], ev.lb[b]
-            x1, x2, c = n + ev.ii[pb], n + ev.kk[pb], self._event_corners()[lb]
-            pairs = np.concatenate(
-                [
-                    np.stack([m, fix[:, 0]], axis=1),
-                    np.stack([m, fix[:, 1]], axis=1),
-                    np.stack([x1, x2], axis=1),
-                    np.stack([x1, c], axis=1),
-                    np.stack([x2, c], axis=1),
-                ]
-            ).astype(np.int64)
-            lo, hi = np.sort(pairs, axis=1).T
-            got = cache[key] = (bool((fix < 0).any()), set((lo * _PAIR + hi).tolist()))
-        unknown, codes = got
+        pairs (:meth:`_candidate_pairs`) are kept per segment."""
+        unknown, codes = self._per_segment(
+            "_ev_pairs", q0, dq, lambda: self._candidate_pairs(q0, dq)
+        )
         if unknown:
             return True
         return not codes.isdisjoint(self._frame_lines(frames)[1])
+
+    def _candidate_pairs(self, q0: np.ndarray, dq: np.ndarray) -> tuple[bool, set]:
+        """For :meth:`_may_be_live`: whether some candidate event of the segment's window
+        (1e-9, 1 - 1e-9) has an unknown anchor (-1), and the pairs of the candidates' anchors
+        that make an event live when a sample's shadow edge lies on their line (one of them
+        moving), as integers (``a * _PAIR + b``, ``a < b``)."""
+        ev = self._times_kept(q0, dq)
+        if ev is None:
+            ev = self._event_times(q0, dq, 1e-9, 1 - 1e-9)
+        a = (ev.ta > 1e-9) & (ev.ta < 1 - 1e-9)
+        b = (ev.tb > 1e-9) & (ev.tb < 1 - 1e-9)
+        fix = self._event_fixed()[ev.la[a]]
+        m = ev.mov_id[ev.xa[a]]
+        n = self.n_fixed
+        pb, lb = ev.pb[b], ev.lb[b]
+        x1, x2, c = n + ev.ii[pb], n + ev.kk[pb], self._event_corners()[lb]
+        pairs = np.concatenate(
+            [
+                np.stack([m, fix[:, 0]], axis=1),
+                np.stack([m, fix[:, 1]], axis=1),
+                np.stack([x1, x2], axis=1),
+                np.stack([x1, c], axis=1),
+                np.stack([x2, c], axis=1),
+            ]
+        ).astype(np.int64)
+        lo, hi = np.sort(pairs, axis=1).T
+        return bool((fix < 0).any()), set((lo * _PAIR + hi).tolist())
 
     def _wedge_sides(
         self, k, n_a, xa, la, w, s_, vx, spans, fix, pb, lb, cvx, ii, kk, qe
