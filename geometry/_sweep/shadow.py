@@ -324,19 +324,128 @@ def _drop_short_many(
 ) -> list[np.ndarray]:
     """:func:`_drop_short` of each closed ring of ``rings``: the rings without a step
     shorter than ``length`` (the closing step included), most of them, are found in one
-    pass and come back as they are (as :func:`_drop_short` returns them)."""
+    pass and come back as they are (as :func:`_drop_short` returns them); the rings whose
+    runs of short steps are all tight (:func:`_tight_runs`: split corners, most of the
+    others) are done in one batch too (:func:`_drop_tight_runs`); the rest one by one."""
     flat = np.concatenate(rings) if rings else np.zeros((0, 2))
     if len(flat) == 0:
         return list(rings)
-    nxt = np.roll(flat, -1, axis=0)
-    off = np.cumsum([0] + [len(v) for v in rings])
-    last = off[1:] - 1  # each ring's closing step: from its last vertex to its first
-    nxt[last[off[1:] > off[:-1]]] = flat[off[:-1][off[1:] > off[:-1]]]
-    short = np.abs(nxt - flat).max(axis=1) < length
-    any_short = np.logical_or.reduceat(short, np.minimum(off[:-1], len(flat) - 1)) & (
-        off[1:] > off[:-1]
-    )
-    return [_drop_short(v, length, vertex_at) if any_short[k] else v for k, v in enumerate(rings)]
+    n_of = np.array([len(v) for v in rings])
+    off = np.concatenate([[0], np.cumsum(n_of)])
+    ring_of = np.repeat(np.arange(len(rings)), n_of)
+    idx = np.arange(len(flat))
+    nxt = np.where(idx + 1 == off[ring_of + 1], off[ring_of], idx + 1)  # closing step included
+    short = np.abs(flat[nxt] - flat).max(axis=1) < length
+    any_short = np.zeros(len(rings), dtype=bool)
+    any_short[ring_of[short]] = True
+    if not any_short.any():
+        return list(rings)
+    prv = np.empty_like(nxt)
+    prv[nxt] = idx
+    s, e, tight = _tight_runs(flat, off, ring_of, nxt, prv, short, length)
+    out = list(rings)
+    batch = np.flatnonzero(any_short & tight)
+    if len(batch):
+        got = _drop_tight_runs(
+            flat, off, ring_of, nxt, prv, short, (s, e), batch, length, vertex_at
+        )
+        for k, v in zip(batch.tolist(), got, strict=True):
+            out[k] = v
+    for k in np.flatnonzero(any_short & ~tight).tolist():
+        out[k] = _drop_short(rings[k], length, vertex_at)
+    return out
+
+
+def _tight_runs(
+    flat: np.ndarray,
+    off: np.ndarray,
+    ring_of: np.ndarray,
+    nxt: np.ndarray,
+    prv: np.ndarray,
+    short: np.ndarray,
+    length: float,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The runs of short steps of the closed rings ``flat[off[r] : off[r + 1]]`` (``nxt``,
+    ``prv``: each vertex's successor and predecessor on its ring; ``short``: its step to
+    the successor is shorter than ``length``): per run, its first vertex ``s`` and its
+    last ``e`` (the steps ``s .. e - 1`` are short, the step from ``e`` is long), and per
+    ring whether all its runs are *tight*: the closing step is long, every vertex of a run
+    lies within ``length`` of the run's first and the vertex after it does not, in a ring
+    of at least 4 vertices.  In such a ring :func:`_drop_short` keeps each run's first
+    vertex and the vertices outside the runs (each vertex kept lies at least ``length``
+    from the one kept before it, and no kept vertex joins vertex 0's cluster), and its
+    clusters are the runs: :func:`_drop_tight_runs` gives what it gives."""
+    tight = np.diff(off) >= 4
+    if short.all():  # no step is long: no run ends (and no ring is tight)
+        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), tight & False
+    last = off[1:][tight] - 1
+    tight[tight] = ~short[last]  # the closing step is long
+    first = short & ~short[prv]  # a run's first vertex (runs do not wrap in tight rings)
+    s = np.flatnonzero(first)
+    longs = np.flatnonzero(~short)
+    e = longs[np.minimum(np.searchsorted(longs, s), len(longs) - 1)]
+    inside = np.flatnonzero(short[prv])  # the vertices a short step enters: s + 1 .. e
+    run = np.cumsum(first)[inside] - 1  # the run each lies in
+    ok = (run >= 0) & (run < len(s))
+    near = np.zeros(len(inside), dtype=bool)
+    near[ok] = np.abs(flat[inside[ok]] - flat[s[run[ok]]]).max(axis=1) < length
+    tight[ring_of[inside[~near]]] = False
+    apart = np.abs(flat[nxt[e]] - flat[s]).max(axis=1) >= length
+    tight[ring_of[s[~apart]]] = False
+    return s, e, tight
+
+
+def _drop_tight_runs(
+    flat: np.ndarray,
+    off: np.ndarray,
+    ring_of: np.ndarray,
+    nxt: np.ndarray,
+    prv: np.ndarray,
+    short: np.ndarray,
+    runs: tuple[np.ndarray, np.ndarray],
+    rings: np.ndarray,
+    length: float,
+    vertex_at: Callable[[np.ndarray], np.ndarray] | None,
+) -> list[np.ndarray]:
+    """:func:`_drop_short` of the rings ``rings`` (indices; all their runs of short steps
+    tight, :func:`_tight_runs`, whose runs ``(s, e)`` are given) in one batch: per run, its
+    vertices after the first are dropped and the first moved to where the lines of the
+    steps entering and leaving the run cross, when that lies within ``4 length`` of it
+    (the same floating-point operations as :func:`_corners`); otherwise, where the run
+    holds two distinct vertices of the environment (``vertex_at``), the first and the last
+    of them are kept, as :func:`_corners` keeps them."""
+    want = np.zeros(len(off) - 1, dtype=bool)
+    want[rings] = True
+    sel = want[ring_of]
+    s, e = runs
+    pick = sel[s]
+    s, e = s[pick], e[pick]
+    a0, a1, b0, b1 = flat[prv[s]], flat[s], flat[e], flat[nxt[e]]
+    da, db = a1 - a0, b1 - b0
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        den = da[:, 0] * db[:, 1] - da[:, 1] * db[:, 0]
+        u = ((b0[:, 0] - a0[:, 0]) * db[:, 1] - (b0[:, 1] - a0[:, 1]) * db[:, 0]) / den
+        cx = np.where(den != 0.0, a0[:, 0] + u * da[:, 0], np.inf)
+        cy = np.where(den != 0.0, a0[:, 1] + u * da[:, 1], np.inf)
+        close = (
+            np.isfinite(cx)
+            & np.isfinite(cy)
+            & (np.maximum(np.abs(cx - a1[:, 0]), np.abs(cy - a1[:, 1])) <= 4.0 * length)
+        )
+    pts = flat.copy()
+    pts[s[close], 0], pts[s[close], 1] = cx[close], cy[close]
+    keep = sel & ~short[prv]
+    if vertex_at is not None:
+        for k in np.flatnonzero(~close).tolist():  # rare: a short edge, not a split corner
+            idx = np.arange(s[k], e[k] + 1)
+            at = vertex_at(flat[idx])
+            env = np.flatnonzero(at >= 0)
+            if len(env) and (at[env] != at[env[0]]).any():
+                pts[s[k]] = flat[idx[env[0]]]
+                keep[idx[env[at[env] != at[env[0]]][-1]]] = True
+    kept = np.flatnonzero(keep)
+    starts, ends = np.searchsorted(kept, off[rings]), np.searchsorted(kept, off[rings + 1])
+    return [pts[kept[a:b]] for a, b in zip(starts.tolist(), ends.tolist(), strict=True)]
 
 
 def _drop_short(

@@ -74,6 +74,99 @@ def test_drop_short_of_many_rings_is_ring_by_ring() -> None:
         assert np.array_equal(c, np.asarray(r.coords)[:-1, :2])
 
 
+def _split_ring(rng: np.random.Generator, length: float) -> tuple[np.ndarray, np.ndarray]:
+    """A random star-shaped ring whose corners are replaced, at random, by clusters of 2-4
+    vertices closer than ``length``: split corners (on the two edges' lines, or a few
+    ulps off them), and short edges whose vertices lie off both lines; the closing step is
+    short in some.  Also, per vertex, an environment vertex id or -1 (for ``vertex_at``)."""
+    n = int(rng.integers(4, 12))
+    ang = np.sort(rng.uniform(0, 2 * np.pi, n))
+    base = np.stack([np.cos(ang), np.sin(ang)], axis=1) * rng.uniform(1, 3, (n, 1))
+    # straight "corners" (an edge's midpoint): there the lines into and out of a cluster
+    # are nearly parallel and cross far from it (the short-edge case of _corners)
+    mids = 0.5 * (base + np.roll(base, -1, axis=0))
+    straight = rng.random(n) < 0.3
+    base = np.stack([base, mids], axis=1).reshape(-1, 2)[
+        np.repeat([True], 2 * n) & np.ravel(np.stack([np.ones(n, dtype=bool), straight], axis=1))
+    ]
+    n = len(base)
+    pts, ids = [], []
+    for i, c in enumerate(base):
+        k = int(rng.choice([1, 1, 2, 3, 4]))
+        if k == 1:
+            pts.append(c)
+            ids.append(int(rng.choice([-1, i])))
+            continue
+        u_in = c - base[i - 1]
+        u_out = base[(i + 1) % n] - c
+        u_in, u_out = u_in / np.hypot(*u_in), u_out / np.hypot(*u_out)
+        off_line = rng.random() < 0.3  # a short edge of its own, not a split corner
+        for j in range(k):
+            f = (j + 0.5) / k - 0.5  # from before the corner to after it
+            p = c + (f * length * 0.6) * (u_in if f < 0 else u_out)
+            if off_line:
+                p = p + rng.normal(size=2) * length * 0.2
+            elif rng.random() < 0.3:
+                p = p + rng.normal(size=2) * 1e-15
+            pts.append(p)
+            ids.append(int(rng.choice([-1, 100 * i + j])))
+    v, at = np.asarray(pts), np.asarray(ids)
+    r = int(rng.integers(0, len(v)))  # a cluster may straddle the closing step
+    return np.roll(v, r, axis=0), np.roll(at, r)
+
+
+def test_drop_short_batches_the_tight_runs_as_ring_by_ring(monkeypatch) -> None:
+    """The rings whose runs of short steps are all tight (geometry._sweep.shadow._tight_runs:
+    split corners of 2-4 vertices, short edges between vertices of the environment) get
+    from the batch exactly what _drop_short gives them one by one, bit for bit; the batch
+    and the ring-by-ring fallback (a cluster across the closing step) both run."""
+    rng = np.random.default_rng(23)
+    length = 1e-6
+    calls = {"one": 0}
+    one = SH._drop_short
+
+    def counted(*a, **k):
+        calls["one"] += 1
+        return one(*a, **k)
+
+    batched = 0
+    for _ in range(300):
+        made = [_split_ring(rng, length) for _ in range(int(rng.integers(1, 6)))]
+        rings = [v for v, _ in made]
+        table = np.concatenate([v for v in rings])
+        ids = np.concatenate([a for _, a in made])
+
+        def vertex_at(p, table=table, ids=ids):
+            near = (np.abs(table[None] - p[:, None]) == 0).all(axis=2)
+            return np.where(near.any(axis=1), ids[np.argmax(near, axis=1)], -1)
+
+        monkeypatch.setattr(SH, "_drop_short", counted)
+        before = calls["one"]
+        got = SH._drop_short_many(rings, length, vertex_at)
+        monkeypatch.setattr(SH, "_drop_short", one)
+        with_short = sum(
+            bool((np.abs(np.roll(v, -1, axis=0) - v).max(axis=1) < length).any()) for v in rings
+        )
+        batched += with_short - (calls["one"] - before)
+        for v, g in zip(rings, got, strict=True):
+            ref = one(v, length, vertex_at)
+            assert g.shape == ref.shape
+            assert np.array_equal(g.view(np.int64), ref.view(np.int64))  # -0.0 too
+    assert batched > 300 and calls["one"] > 50  # both paths taken, many times
+    # a ring whose cluster straddles its closing step, after a ring with a run where its
+    # vertex 0 is (rings touch at a vertex): the run of the one must not pass for the other's
+    b = np.array([[3.0, 3.0], [4.0, 3.0], [4.0, 4.0], [0.0, 0.0], [3e-7, 1e-7]])
+    a = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0], [-3e-7, 2e-7]])
+    c = np.array([[5.0, 5.0], [6.0, 5.0], [6.0, 6.0], [5.0, 6.0]])
+    # a run whose next vertex, after a long step, is back within ``length`` of the run's
+    # first (the greedy drops it too): not tight
+    d = np.array([[0.0, 0.0], [6e-7, 0.0], [-5e-7, 0.0], [1.0, 0.5], [0.5, 1.0]])
+    for g, v in zip(SH._drop_short_many([b, a, c, d], length), [b, a, c, d], strict=True):
+        assert np.array_equal(g, one(v, length))
+    tiny = a * 1e-7  # every step short, in the only ring
+    assert np.array_equal(SH._drop_short_many([tiny], length)[0], one(tiny, length))
+
+
 def _sweeper(monkeypatch, scene: Scene | None = None) -> S.Sweeper:
     """The sweeper of the swept partial query over G on ``scene`` (default ``lab``)."""
     got = {}
