@@ -211,7 +211,7 @@ class _Run:
         got = self.frames.get(t)
         if got is None:
             sw = self.sw
-            q = self.q1 if t == 1.0 else self.q0 + t * self.dq
+            q = self.at(t)
             key = (float(q[0]), float(q[1]))
             if key not in sw._frames:
                 shadow, table, tid = sw.shadow(q)
@@ -219,6 +219,10 @@ class _Run:
                 self.stats["samples"] += 1
             got = self.frames[t] = sw._frames[key]
         return got
+
+    def at(self, t: float) -> np.ndarray:
+        """The reference point at time ``t`` (``q1`` itself at 1)."""
+        return self.q1 if t == 1.0 else self.q0 + t * self.dq
 
 
 @dataclass
@@ -385,6 +389,29 @@ class Sweeper(StationaryShadows, PointTest, CollinearityEvents, Coverage, BirthC
                 ids.append(aid)
         return np.asarray(pts), np.asarray(wanted), np.asarray(ids)
 
+    def _frames_many(self, items: list[tuple[_Run, float]]) -> None:
+        """``run.frame(t)`` for each ``(run, t)`` of ``items``, in that order, with the edges
+        of the new shadows labelled in one batch (:meth:`_edges_many`: each gets what
+        :meth:`_edges` gives it alone; a configuration is computed once, counted as a
+        sample of the first run that asks for it, as one by one)."""
+        todo: dict[tuple[float, float], tuple[_Run, np.ndarray]] = {}
+        for r, t in items:
+            if t in r.frames:
+                continue
+            q = r.at(t)
+            key = (float(q[0]), float(q[1]))
+            if key not in self._frames and key not in todo:
+                todo[key] = (r, q)
+        if len(todo) > 1:
+            shadows = [self.shadow(q) for _, q in todo.values()]
+            for (key, (r, _)), sh, edges in zip(
+                todo.items(), shadows, self._edges_many(shadows), strict=True
+            ):
+                self._frames[key] = (sh[0], edges)
+                r.stats["samples"] += 1
+        for r, t in items:
+            r.frame(t)
+
     # ------------------------------------------------------------------ sweep
     def along(self, q0: np.ndarray, q1: np.ndarray) -> tuple[list[shapely.Geometry], dict]:
         """Pieces whose union is the union of the shadows S(q) for q on the
@@ -430,9 +457,7 @@ class Sweeper(StationaryShadows, PointTest, CollinearityEvents, Coverage, BirthC
                 ],
                 pairs + [p for ps in split.values() for p in ps],
             )
-            for run, ts in zip(runs, ts_all, strict=True):
-                for t in ts:
-                    run.frame(t)
+            self._frames_many([(run, t) for run, ts in zip(runs, ts_all, strict=True) for t in ts])
         if moving:
             with clock("birth checks"):
                 # the first level is the one whose bounds the vertex batch computed
@@ -451,9 +476,7 @@ class Sweeper(StationaryShadows, PointTest, CollinearityEvents, Coverage, BirthC
                 if not asked:
                     break
                 self._prefetch([r.q0 + t * r.dq for r, mids in asked for t in mids])
-                for r, mids in asked:
-                    for t in mids:
-                        r.frame(t)
+                self._frames_many([(r, t) for r, mids in asked for t in mids])
         with clock("tracing"):
             # the first round of every segment's traces in one batch
             jobs = [(r.q0, r.q1, r.frame, _open_pairs(r)) for r in moving]
@@ -484,6 +507,7 @@ class Sweeper(StationaryShadows, PointTest, CollinearityEvents, Coverage, BirthC
             if not mids:
                 return pieces
             self._prefetch([q0 + t * dq for t in mids])
+            self._frames_many([(run, t) for t in mids])
             for t in mids:
                 pieces.append(frame(t)[0])
             grid = sorted(set(run.frames) | set(mids))

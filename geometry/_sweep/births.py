@@ -83,8 +83,8 @@ class BirthChecks:
                 left = {i for i, born in alarms if self._settled(*level[i][:3], born, halves[i])}
                 mids = [m for i, m in zip(new_at, mids, strict=True) if i not in left]
             self._prefetch([r.q0 + m * r.dq for r, _, m, _, _ in mids])
+            self._frames_many([(r, m) for r, _, m, _, _ in mids])
             for r, a, m, b, depth in mids:
-                r.frame(m)
                 r.stats["refined"] += 1
                 todo += [(r, a, m, depth + 1), (r, m, b, depth + 1)]
 

@@ -106,16 +106,26 @@ class StationaryShadows:
     def _edges(self, shadow: shapely.Geometry, table: np.ndarray, tid: np.ndarray) -> list:
         """Edges of ``shadow`` on moving lines: ``(key_prev, key, key_next)``, each
         key a pair of anchor ids spanning the line (shadow on the edge's left)."""
-        out = []
+        return self._edges_many([(shadow, table, tid)])[0]
+
+    def _edges_many(self, shadows: list[tuple]) -> list[list]:
+        """:meth:`_edges` of each ``(shadow, table, tid)`` of ``shadows`` (:meth:`shadow`'s
+        answers), the rings of all of them in one batch: every step below is ring by ring
+        (:meth:`_label_rows` row by row, each row with its own shadow's anchor table), so
+        each shadow gets what it would alone."""
+        out: list[list] = [[] for _ in shadows]
         n = self.n_fixed
-        merged = _drop_short_many(
-            _ring_coords(_rings(shapely.orient_polygons(shadow, exterior_cw=False))),
-            self.tol_lab,
-            self._vertex_at,
-        )
-        vs = [v for v in merged if len(v) >= 3]
-        if not vs:
+        per = [
+            _ring_coords(_rings(shapely.orient_polygons(sh, exterior_cw=False)))
+            for sh, _, _ in shadows
+        ]
+        merged = _drop_short_many([r for rs in per for r in rs], self.tol_lab, self._vertex_at)
+        of = np.repeat(np.arange(len(shadows)), [len(rs) for rs in per])
+        big = [k for k, v in enumerate(merged) if len(v) >= 3]
+        if not big:
             return out
+        vs = [merged[k] for k in big]
+        shadow_of = of[big]  # per ring kept: its shadow
         # all rings labelled in one batch (row by row, so as if ring by ring)
         flat = np.concatenate(vs)
         off = np.cumsum([0] + [len(v) for v in vs])
@@ -131,7 +141,8 @@ class StationaryShadows:
         need = ~fixed | ~fixed[nxt] | ~fixed[prv]
         all_keys = np.full((len(flat), 2), -1, dtype=np.int64)
         if need.any():
-            all_keys[need] = self._label(flat[need], table, tid, d=d[need])
+            tables = [(table, tid) for _, table, tid in shadows]
+            all_keys[need] = self._label_rows(flat[need], d[need], tables, shadow_of[ring_of[need]])
         # consecutive edges on one line (the same key) are one shadow edge: the overlay can
         # leave a vertex inside an edge (a node of another ring, a hot pixel), and its pieces
         # would each see their own line as a neighbour and be dropped below (a shadow traced
@@ -151,8 +162,8 @@ class StationaryShadows:
         moving = (keys >= n).any(axis=1) & (keys >= 0).all(axis=1)
         ok = moving & (kp >= 0).all(axis=1) & (kn >= 0).all(axis=1)
         ok &= ~(kp == keys).all(axis=1) & ~(kn == keys).all(axis=1)
-        for j in np.flatnonzero(ok):
-            out.append((tuple(kp[j]), tuple(keys[j]), tuple(kn[j])))
+        for j in np.flatnonzero(ok).tolist():
+            out[shadow_of[kr[j]]].append((tuple(kp[j]), tuple(keys[j]), tuple(kn[j])))
         return out
 
     def _fixed_edges(self, v: np.ndarray, off: np.ndarray) -> np.ndarray:
@@ -202,10 +213,33 @@ class StationaryShadows:
         edges ``v[i] -> v[i] + d[i]`` of any rings)."""
         if d is None:
             d = np.roll(v, -1, axis=0) - v
+        return self._label_rows(v, d, [(table, tid)], np.zeros(len(v), dtype=np.int64))
+
+    def _label_rows(
+        self, v: np.ndarray, d: np.ndarray, tables: list[tuple], row_table: np.ndarray
+    ) -> np.ndarray:
+        """Per edge ``v[i] -> v[i] + d[i]``: two anchor ids spanning its line, or -1, from
+        the anchor table ``tables[row_table[i]]`` (``(table, tid)``: positions and ids,
+        :meth:`shadow`), row by row (the tables padded to one length with points that lie
+        on no line)."""
+        size = max(len(t) for t, _ in tables)
+        tab_all = np.full((len(tables), size, 2), np.nan)
+        ids_all = np.full((len(tables), size), -1, dtype=np.int64)
+        for k, (table, tid) in enumerate(tables):
+            # prefer fixed anchors, then moving ones (in table order); the padding sorts
+            # with the fixed ones but is never a candidate (NaN)
+            perm = np.argsort(tid >= self.n_fixed, kind="stable")
+            tab_all[k, : len(table)] = table[perm]
+            ids_all[k, : len(tid)] = tid[perm]
         ln = np.hypot(d[:, 0], d[:, 1])
-        dist = np.abs(_cross(d[:, None, :], table[None, :, :] - v[:, None, :])) / np.maximum(
-            ln[:, None], 1e-300
-        )
+        # |d x (table - v)| / |d|, the cross product's terms computed as _cross does, on
+        # the coordinates apart (no (E, T, 2) temporaries)
+        tx, ty = tab_all[row_table, :, 0], tab_all[row_table, :, 1]
+        rx = tx - v[:, None, 0]
+        ry = ty - v[:, None, 1]
+        with np.errstate(invalid="ignore"):
+            dist = np.abs(d[:, None, 0] * ry - d[:, None, 1] * rx) / np.maximum(ln[:, None], 1e-300)
+            on = dist <= self.tol_lab
         keys = np.full((len(v), 2), -1, dtype=np.int64)
         # two distinct positions on the line; prefer fixed anchors, then moving ones (in
         # table order): the first pair (i, j), i before j in that order, of candidates
@@ -214,12 +248,9 @@ class StationaryShadows:
         # line, but the line they span points anywhere: the edge's ends must lie on it
         # (fuzz seed 205296: a sliver's shadow edges were keyed to the sliver's ends,
         # read as fixed, and never traced)
-        perm = np.argsort(tid >= self.n_fixed, kind="stable")
-        on = (dist <= self.tol_lab)[:, perm]
-        r_on, c_on = np.nonzero(on)  # row-major: by row, then in perm order
+        r_on, c_on = np.nonzero(on)  # row-major: by row, then in preference order
         if len(r_on) == 0:
             return keys
-        tab = table[perm]
         # the candidates are few per row: their pairs (i, j), i < j, in one row
         cnt = np.bincount(r_on, minlength=len(v))
         pi, pj = [], []
@@ -231,16 +262,20 @@ class StationaryShadows:
             return keys
         pi, pj = np.concatenate(pi), np.concatenate(pj)
         ci, cj = c_on[pi], c_on[pj]
-        good = np.abs(tab[cj] - tab[ci]).max(axis=1) > self.tol_lab
         rr = r_on[pi]
-        good[good] = self._fits(tab[ci[good]], tab[cj[good]], v[rr[good]], d[rr[good]])
+        tr = row_table[rr]
+        ti, tj = tab_all[tr, ci], tab_all[tr, cj]
+        good = np.abs(tj - ti).max(axis=1) > self.tol_lab
+        good[good] = self._fits(ti[good], tj[good], v[rr[good]], d[rr[good]])
         pi, pj, rr = pi[good], pj[good], rr[good]
         order = np.lexsort((pj, pi))  # the first pair of each row
         rr_s = rr[order]
         r_first, first = np.unique(rr_s, return_index=True)
-        ids = tid[perm]
         sel = order[first]
-        keys[r_first] = np.sort(np.stack([ids[c_on[pi[sel]]], ids[c_on[pj[sel]]]], axis=1), axis=1)
+        ts = row_table[r_on[pi[sel]]]
+        keys[r_first] = np.sort(
+            np.stack([ids_all[ts, c_on[pi[sel]]], ids_all[ts, c_on[pj[sel]]]], axis=1), axis=1
+        )
         # an edge too short for two anchors "far" apart whose ends are two vertices of
         # the environment lies on their line (a short edge that _drop_short kept)
         short = np.flatnonzero((keys[:, 0] < 0) & (np.abs(d).max(axis=1) <= self.tol_lab))

@@ -425,6 +425,7 @@ def test_label_wants_the_edge_on_the_pair_line():
         tol_lab = 1e-8
         n_fixed = 4
         _fits = Sweeper._fits
+        _label_rows = Sweeper._label_rows
 
         def _vertex_at(self, pts):
             return np.full(len(pts), -1)

@@ -197,6 +197,64 @@ def test_batched_labels_equal_ring_by_ring(monkeypatch) -> None:
     assert n_moving > 0
 
 
+def test_edges_of_many_shadows_are_shadow_by_shadow(monkeypatch) -> None:
+    """_edges_many labels the rings of several shadows in one batch, each row against its
+    own shadow's anchor table (padded to one length): every shadow gets the edges it gets
+    alone, bit for bit (the 5.2 sweeps of ``lab`` and its swept query); and rows against
+    tables of different lengths (overlap strips that cut the outline add anchors) get
+    what each table gives them alone."""
+    sweepers = []
+    orig = S.Sweeper.along_many
+
+    def along_many(self, *a, **k):
+        sweepers.append(self)
+        return orig(self, *a, **k)
+
+    monkeypatch.setattr(S.Sweeper, "along_many", along_many)
+    scene = Scene.load("sensorplan_gym/scenes/lab.json")
+    recognizable_region(scene, model="partial", theta=0.0)
+    partial_region(scene, target_in="goal", theta=0.0)
+    moving = 0
+    for sw in sweepers:
+        shadows = [sw.shadow(np.asarray(key)) for key in sw._frames]
+        batch = sw._edges_many(shadows)
+        for sh, got in zip(shadows, batch, strict=True):
+            assert got == sw._edges_many([sh])[0]
+            moving += len(got)
+        assert batch == [e for _, e in sw._frames.values()]  # what the sweep kept
+    assert len(sweepers) == 3 and moving > 20
+    # padding: the second table is the first with three more moving anchors (on no
+    # edge's line) ahead of the target's, the third the first without its last target
+    # vertex
+    sw = sweepers[-1]
+    rows, tables, of, n_rows = [], [], [], 0
+    for key in list(sw._frames)[:4]:
+        shadow, table, tid = sw.shadow(np.asarray(key))
+        v = np.concatenate(SH._ring_coords(SH._rings(shapely.orient_polygons(shadow))))
+        d = np.roll(v, -1, axis=0) - v
+        extra = np.array([[1e3, 7e2], [-3e3, 1.1e3], [5e2, -2.9e3]])
+        n = sw.n_fixed  # the extra anchors before the target's: the columns shift
+        more = (
+            np.vstack([table[:n], extra, table[n:]]),
+            np.concatenate([tid[:n], tid.max() + 1 + np.arange(3), tid[n:]]),
+        )
+        fewer = (table[:-1], tid[:-1])
+        for t in ((table, tid), more, fewer):
+            rows.append((v, d, sw._label(v, *t, d=d)))
+            tables.append(t)
+            of.append(np.full(len(v), len(tables) - 1))
+            n_rows += len(v)
+    v_all = np.concatenate([r[0] for r in rows])
+    d_all = np.concatenate([r[1] for r in rows])
+    got = sw._label_rows(v_all, d_all, tables, np.concatenate(of))
+    assert np.array_equal(got, np.concatenate([r[2] for r in rows]))
+    assert len({len(t) for t, _ in tables}) == 3 and (got >= sw.n_fixed).any()
+    # the order of the rows does not matter either
+    perm = np.random.default_rng(3).permutation(n_rows)
+    again = sw._label_rows(v_all[perm], d_all[perm], tables, np.concatenate(of)[perm])
+    assert np.array_equal(again, got[perm])
+
+
 def _all_at_once(sw: S.Sweeper, vs, ve, ts, q0, dq) -> tuple[np.ndarray, np.ndarray]:
     """Validity with every probe tested at once (the definition), and with the first
     round's probes only."""
