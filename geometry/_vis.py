@@ -174,13 +174,18 @@ def _unblocked(
     ``owner`` into free space: inside both wedges of :func:`_blocking` (where present)
     and not to the right of the segment the viewpoint lies on."""
     open_ = np.ones(len(mid), dtype=bool)
+    # only the gaps of viewpoints with a wedge (or a segment) are tested: the others are
+    # open whatever the test says (the sine and cosine of every gap were most of the time)
     for w in (w1, w2):
         w0 = w[owner, 0]
-        with np.errstate(invalid="ignore"):
-            open_ &= np.isnan(w0) | (((mid - w0) % TAU) < w[owner, 1])
-    ax, ay = along[owner, 0], along[owner, 1]
-    with np.errstate(invalid="ignore"):
-        open_ &= np.isnan(ax) | (ax * _libm.sin(mid) - ay * _libm.cos(mid) >= 0)
+        k = np.flatnonzero(~np.isnan(w0))
+        if len(k):
+            open_[k] &= ((mid[k] - w0[k]) % TAU) < w[owner[k], 1]
+    ax = along[owner, 0]
+    k = np.flatnonzero(~np.isnan(ax))
+    if len(k):
+        m = mid[k]
+        open_[k] &= ax[k] * _libm.sin(m) - along[owner[k], 1] * _libm.cos(m) >= 0
     return open_
 
 

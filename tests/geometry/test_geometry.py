@@ -376,3 +376,31 @@ def test_gaps_without_their_end_points_are_the_same_gaps():
             np.testing.assert_array_equal(getattr(bare, k), getattr(full, k))
         assert np.isnan(bare.p0).all() and np.isnan(bare.p1).all()
     assert n > 200 and (full.seg >= 0).sum() > 1000 and np.isfinite(full.p0).all()
+
+
+def test_unblocked_tests_only_the_viewpoints_on_the_boundary():
+    """_vis._unblocked computes its wedge and segment tests only for the gaps of viewpoints
+    that have a wedge or a segment (NaN rows are open): the answer is the definition's,
+    every gap tested, bit for bit, on viewpoints with none, one or two wedges and a
+    segment through them."""
+    from geometry import _libm
+    from geometry._vis import TAU, _unblocked
+
+    rng = np.random.default_rng(5)
+    n, g = 40, 4000
+    w1, w2, along = (np.full((n, 2), np.nan) for _ in range(3))
+    w1[:25] = np.stack([rng.uniform(-4, 4, 25), rng.uniform(0, TAU, 25)], axis=1)
+    w2[:6] = np.stack([rng.uniform(-4, 4, 6), rng.uniform(0, TAU, 6)], axis=1)
+    along[30:36] = rng.normal(size=(6, 2))
+    owner = np.sort(rng.integers(0, n, g))
+    mid = rng.uniform(-np.pi, 3 * np.pi, g)
+    want = np.ones(g, dtype=bool)
+    with np.errstate(invalid="ignore"):
+        for w in (w1, w2):
+            w0 = w[owner, 0]
+            want &= np.isnan(w0) | (((mid - w0) % TAU) < w[owner, 1])
+        ax, ay = along[owner, 0], along[owner, 1]
+        want &= np.isnan(ax) | (ax * _libm.sin(mid) - ay * _libm.cos(mid) >= 0)
+    got = _unblocked(mid, owner, w1, w2, along)
+    assert np.array_equal(got, want)
+    assert 0 < int((~got).sum()) < g  # both answers occur
