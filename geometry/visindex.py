@@ -54,6 +54,7 @@ __all__ = [
     "first_hits",
     "grid_for",
     "near_pairs",
+    "on_lines",
     "sorted_gaps",
     "window_ranges",
 ]
@@ -773,3 +774,40 @@ def window_ranges(
         his.append(hi[:m])
         owns.append(ow[:m])
     return np.concatenate(los), np.concatenate(his), np.concatenate(owns)
+
+
+@_njit
+def _on_lines_kernel(v, d, ln, tab, row_table, tol, rows, cols, fill):  # pragma: no cover
+    k = 0
+    for i in range(v.shape[0]):
+        t = row_table[i]
+        den = max(ln[i], 1e-300)
+        for c in range(tab.shape[1]):
+            rx = tab[t, c, 0] - v[i, 0]
+            ry = tab[t, c, 1] - v[i, 1]
+            if abs(d[i, 0] * ry - d[i, 1] * rx) / den <= tol:
+                if fill:
+                    rows[k] = i
+                    cols[k] = c
+                k += 1
+    return k
+
+
+def on_lines(
+    v: np.ndarray, d: np.ndarray, tab: np.ndarray, row_table: np.ndarray, tol: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """Compiled twin of the candidate search of
+    :meth:`geometry._sweep.shadow.StationaryShadows._label_rows`: the pairs ``(row,
+    column)``, row-major, where point ``tab[row_table[row], column]`` (a NaN point: never)
+    lies within ``tol`` of the line through ``v[row]`` along ``d[row]`` (the distance
+    ``|d x (p - v)| / max(|d|, 1e-300)``, the same expressions as the numpy code)."""
+    v = np.ascontiguousarray(v, dtype=np.float64)
+    d = np.ascontiguousarray(d, dtype=np.float64)
+    ln = np.hypot(d[:, 0], d[:, 1])
+    tab = np.ascontiguousarray(tab, dtype=np.float64)
+    row_table = np.ascontiguousarray(row_table, dtype=np.int64)
+    none = np.zeros(0, dtype=np.int64)
+    n = _on_lines_kernel(v, d, ln, tab, row_table, tol, none, none, False)
+    rows, cols = np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int64)
+    _on_lines_kernel(v, d, ln, tab, row_table, tol, rows, cols, True)
+    return rows, cols

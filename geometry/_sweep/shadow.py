@@ -15,6 +15,7 @@ from collections.abc import Callable
 import numpy as np
 import shapely
 
+from .. import visindex as _visindex
 from .._common import polygonal
 from .._shapes import areal, snapped
 from .._shapes import cross as _cross
@@ -231,15 +232,10 @@ class StationaryShadows:
             perm = np.argsort(tid >= self.n_fixed, kind="stable")
             tab_all[k, : len(table)] = table[perm]
             ids_all[k, : len(tid)] = tid[perm]
-        ln = np.hypot(d[:, 0], d[:, 1])
-        # |d x (table - v)| / |d|, the cross product's terms computed as _cross does, on
-        # the coordinates apart (no (E, T, 2) temporaries)
-        tx, ty = tab_all[row_table, :, 0], tab_all[row_table, :, 1]
-        rx = tx - v[:, None, 0]
-        ry = ty - v[:, None, 1]
-        with np.errstate(invalid="ignore"):
-            dist = np.abs(d[:, None, 0] * ry - d[:, None, 1] * rx) / np.maximum(ln[:, None], 1e-300)
-            on = dist <= self.tol_lab
+        if _visindex.available():  # the compiled twin of _on_lines
+            r_on, c_on = _visindex.on_lines(v, d, tab_all, row_table, self.tol_lab)
+        else:
+            r_on, c_on = _on_lines(v, d, tab_all, row_table, self.tol_lab)
         keys = np.full((len(v), 2), -1, dtype=np.int64)
         # two distinct positions on the line; prefer fixed anchors, then moving ones (in
         # table order): the first pair (i, j), i before j in that order, of candidates
@@ -247,8 +243,8 @@ class StationaryShadows:
         # apart (the two vertices at a sliver's end, 1e-8 across) both lie on the edge's
         # line, but the line they span points anywhere: the edge's ends must lie on it
         # (fuzz seed 205296: a sliver's shadow edges were keyed to the sliver's ends,
-        # read as fixed, and never traced)
-        r_on, c_on = np.nonzero(on)  # row-major: by row, then in preference order
+        # read as fixed, and never traced).  The candidates come row-major: by row, then
+        # in preference order
         if len(r_on) == 0:
             return keys
         # the candidates are few per row: their pairs (i, j), i < j, in one row
@@ -329,6 +325,22 @@ class StationaryShadows:
                     got[idx] = shapely.dwithin(seen, pts, 1e-6 * env.scale)
             self._anchor_mask = got
         return got
+
+
+def _on_lines(
+    v: np.ndarray, d: np.ndarray, tab: np.ndarray, row_table: np.ndarray, tol: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """The pairs ``(row, column)``, row-major, where the point ``tab[row_table[row],
+    column]`` (a NaN point: never) lies within ``tol`` of the line through ``v[row]`` along
+    ``d[row]``: ``|d x (p - v)| / max(|d|, 1e-300) <= tol``, the cross product's terms as
+    :func:`~geometry._shapes.cross` computes them (numpy; :func:`geometry.visindex.on_lines`
+    is its compiled twin)."""
+    ln = np.hypot(d[:, 0], d[:, 1])
+    rx = tab[row_table, :, 0] - v[:, None, 0]
+    ry = tab[row_table, :, 1] - v[:, None, 1]
+    with np.errstate(invalid="ignore"):
+        dist = np.abs(d[:, None, 0] * ry - d[:, None, 1] * rx) / np.maximum(ln[:, None], 1e-300)
+        return np.nonzero(dist <= tol)
 
 
 def _rings(g: shapely.Geometry) -> list:

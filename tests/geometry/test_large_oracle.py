@@ -281,3 +281,58 @@ def test_viewpoints_off_the_grid():
     assert len(x[0]) > 30
     for u, v in zip(x, y, strict=True):
         assert np.array_equal(u, v)
+
+
+@pytest.mark.skipif(not visindex.available(), reason="numba not installed (fast extra)")
+def test_compiled_line_candidates_equal_numpy(monkeypatch):
+    """The label's candidate search (visindex.on_lines) returns exactly the pairs of the
+    numpy code (geometry._sweep.shadow._on_lines), row-major: on the shadow edges of a
+    real swept query's samples against their padded anchor tables, and on random lines
+    with points on them (to rounding), off them by the tolerance, and NaN padding; and the
+    labels of the sweep's shadows are those of the numpy path."""
+    from geometry import sweep
+    from geometry._sweep import shadow as SH
+
+    d = scene_with_edges(60, 1)
+    g = shapely.Polygon(d["goal"])
+    c = g.representative_point()
+    r = 0.8 * g.exterior.distance(c)
+    ang = 0.3 + 2 * np.pi * np.arange(5) / 5
+    d["goal"] = np.column_stack([c.x + r * np.cos(ang), c.y + r * np.sin(ang)]).tolist()
+    calls = []
+    orig = sweep.Sweeper._label_rows
+
+    def spy(self, v, dd, tables, row_table):
+        calls.append((self, v.copy(), dd.copy(), tables, row_table.copy()))
+        return orig(self, v, dd, tables, row_table)
+
+    monkeypatch.setattr(sweep.Sweeper, "_label_rows", spy)
+    partial_region(Scene.from_dict(d), target_in="goal", theta=0.3)
+    assert calls
+    n_pairs = 0
+    for sw, v, dd, tables, row_table in calls:
+        fast = orig(sw, v, dd, tables, row_table)
+        monkeypatch.setattr(visindex, "_HAVE_NUMBA", False)
+        slow = orig(sw, v, dd, tables, row_table)
+        monkeypatch.setattr(visindex, "_HAVE_NUMBA", True)
+        assert np.array_equal(fast, slow) and (fast >= sw.n_fixed).any()
+    rng = np.random.default_rng(4)
+    for _ in range(20):
+        n, t, k = 60, 50, 3
+        v = rng.normal(size=(n, 2))
+        dd = rng.normal(size=(n, 2)) * rng.choice([1.0, 1e-9, 0.0], size=(n, 1), p=[0.8, 0.1, 0.1])
+        tab = rng.normal(size=(k, t, 2))
+        row_table = rng.integers(0, k, n)
+        for i in range(0, n, 3):  # points on (and near) each third row's line
+            s = rng.normal(size=4)
+            off = rng.choice([0.0, 1e-8, -1e-8, 1e-7], size=4)
+            nrm = np.array([-dd[i, 1], dd[i, 0]]) / max(np.hypot(*dd[i]), 1e-300)
+            cols = rng.integers(0, t, 4)
+            tab[row_table[i], cols] = v[i] + s[:, None] * dd[i] + off[:, None] * nrm
+        tab[:, -5:] = np.nan  # padding
+        fast = visindex.on_lines(v, dd, tab, row_table, 1e-8)
+        slow = SH._on_lines(v, dd, tab, row_table, 1e-8)
+        for x, y in zip(fast, slow, strict=True):
+            assert np.array_equal(x, y)
+        n_pairs += len(fast[0])
+    assert n_pairs > 100
