@@ -227,8 +227,8 @@ class StationaryShadows:
         tab_all = np.full((len(tables), size, 2), np.nan)
         ids_all = np.full((len(tables), size), -1, dtype=np.int64)
         for k, (table, tid) in enumerate(tables):
-            # prefer fixed anchors, then moving ones (in table order); the padding sorts
-            # with the fixed ones but is never a candidate (NaN)
+            # prefer fixed anchors, then moving ones (in table order); the padding after
+            # them (NaN points) is never a candidate
             perm = np.argsort(tid >= self.n_fixed, kind="stable")
             tab_all[k, : len(table)] = table[perm]
             ids_all[k, : len(tid)] = tid[perm]
