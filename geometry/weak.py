@@ -313,6 +313,11 @@ def snap_to_boundary(
     wanted = wanted0 = np.asarray(wanted, dtype=bool)
     if len(env.seg) == 0 or len(ring) < 3:
         return ring, wanted
+    # only the boundary within reach can touch: every test below is within tol of the ring
+    # (50 tol for step 1's vertices, which move the ring by no more), and keeps its order
+    vert, seg = _within_reach(env, ring, (NEAR_REL + 2.0) * tol)
+    if len(seg) == 0:
+        return ring, wanted
     out = ring.copy()
     rows = np.arange(len(out))
     # 1. vertices onto the boundary (a boundary vertex first, else a segment's foot)
@@ -321,42 +326,45 @@ def snap_to_boundary(
     #    from the target's corner) were snapped or inserted as rounding fell, frame by frame
     #    (seed 108386).  Half of the target's own merge distance, so two ring vertices never
     #    land on one boundary vertex; each boundary vertex takes its nearest ring vertex.
-    dv = np.hypot(*(env.vert[None, :, :] - out[:, None, :]).transpose(2, 0, 1))
-    jv = np.argmin(dv, axis=1)
-    on_v = dv[rows, jv] <= 0.5 * NEAR_REL * tol
-    if on_v.sum() > 1:
-        nearest = np.argmin(np.where(on_v[:, None], dv, np.inf), axis=0)  # per boundary vertex
-        on_v &= nearest[jv] == rows
-    foot, ds = _feet(env.seg, out)
+    if len(vert):
+        dv = np.hypot(*(vert[None, :, :] - out[:, None, :]).transpose(2, 0, 1))
+        jv = np.argmin(dv, axis=1)
+        on_v = dv[rows, jv] <= 0.5 * NEAR_REL * tol
+        if on_v.sum() > 1:
+            nearest = np.argmin(np.where(on_v[:, None], dv, np.inf), axis=0)  # per vertex
+            on_v &= nearest[jv] == rows
+    else:
+        jv, on_v = np.zeros(len(out), dtype=np.int64), np.zeros(len(out), dtype=bool)
+    foot, ds = _feet(seg, out)
     js = np.argmin(ds, axis=1)
     on_s = ~on_v & (ds[rows, js] <= tol)
-    out[on_v] = env.vert[jv[on_v]]
+    out[on_v] = vert[jv[on_v]]
     out[on_s] = foot[rows[on_s], js[on_s]]
     # 2. boundary vertices on the ring's segments.  One that touches both segments at a
     #    ring vertex (1.7 tol from it, within tol of both lines) touches the corner: the
     #    vertex moves onto it, else it was inserted on both sides and the ring got a spike
     #    1e-9 long whose fans were decided by rounding (fuzz contact seed 104657)
-    on_seg = _on_segments(env.vert, out, tol)
+    on_seg = _on_segments(vert, out, tol)
     corner = on_seg & np.roll(on_seg, -1, axis=0)  # [i, j]: on the segments into and out of i+1
     if corner.any():
         ci, cj = np.nonzero(corner)
         _, first = np.unique((ci + 1) % len(out), return_index=True)
-        out[(ci[first] + 1) % len(out)] = env.vert[cj[first]]
+        out[(ci[first] + 1) % len(out)] = vert[cj[first]]
         on_v[(ci[first] + 1) % len(out)] = True
-        on_seg = _on_segments(env.vert, out, tol)
+        on_seg = _on_segments(vert, out, tol)
     seg_i, vert_j = np.nonzero(on_seg)
     if not (on_v | on_s).any() and len(seg_i) == 0:
         return ring, wanted
     p0 = out
     e = np.roll(out, -1, axis=0) - p0
-    t = ((env.vert[None, :, :] - p0[:, None, :]) * e[:, None, :]).sum(axis=2) / np.maximum(
+    t = ((vert[None, :, :] - p0[:, None, :]) * e[:, None, :]).sum(axis=2) / np.maximum(
         (e * e).sum(axis=1), 1e-300
     )[:, None]
     if len(seg_i):
         # merge: original vertex i sorts at (i, -1), an inserted one at (i, t)
         key_i = np.concatenate([rows, seg_i])
         key_t = np.concatenate([np.full(len(rows), -1.0), t[seg_i, vert_j]])
-        pts = np.concatenate([out, env.vert[vert_j]])
+        pts = np.concatenate([out, vert[vert_j]])
         flags = np.concatenate([wanted, wanted[seg_i]])
         order = np.lexsort((key_t, key_i))
         out, wanted = pts[order], flags[order]
@@ -366,7 +374,20 @@ def snap_to_boundary(
         return ring, np.asarray(wanted0, dtype=bool)
     # 3. the covered parts of the ring's segments (within tol of the boundary): cut there,
     #    not wanted
-    return _cut_covered(env.seg, out, wanted, tol)
+    return _cut_covered(seg, out, wanted, tol)
+
+
+def _within_reach(env: Domain, ring: np.ndarray, reach: float) -> tuple[np.ndarray, np.ndarray]:
+    """The boundary vertices and segments of ``env`` (in their order) whose bounding boxes
+    come within ``reach`` (max-norm) of the bounding box of ``ring``: every one that can be
+    within ``reach`` of a point of the ring."""
+    lo, hi = ring.min(axis=0) - reach, ring.max(axis=0) + reach
+    v, s = env.vert, env.seg
+    near_v = (v >= lo).all(axis=1) & (v <= hi).all(axis=1)
+    s_lo = np.minimum(s[:, :2], s[:, 2:])
+    s_hi = np.maximum(s[:, :2], s[:, 2:])
+    near_s = (s_hi >= lo).all(axis=1) & (s_lo <= hi).all(axis=1)
+    return v[near_v], s[near_s]
 
 
 def _on_segments(vert: np.ndarray, ring: np.ndarray, tol: float) -> np.ndarray:

@@ -404,3 +404,44 @@ def test_unblocked_tests_only_the_viewpoints_on_the_boundary():
     got = _unblocked(mid, owner, w1, w2, along)
     assert np.array_equal(got, want)
     assert 0 < int((~got).sum()) < g  # both answers occur
+
+
+def test_snap_to_boundary_looks_only_within_reach(monkeypatch):
+    """weak.snap_to_boundary tests only the boundary within reach of the target (its
+    bounding box grown by (NEAR_REL + 2) contact tolerances): the same ring and flags, bit
+    for bit, as with the whole boundary, on targets of fuzz contact scenes (flush, touching,
+    near-miss) moved about, and on targets far from every obstacle."""
+    from geometry import weak
+    from geometry._common import scene_domain
+    from geometry._shapes import ccw_ring
+    from geometry.fuzz import fuzz_scene
+
+    rng = np.random.default_rng(9)
+    cases = touched = 0
+    whole = lambda env, ring, reach: (env.vert, env.seg)  # noqa: E731 - the reference
+    for seed in range(104600, 104640):
+        d = fuzz_scene(seed, contacts=True)
+        if d is None:
+            continue
+        s = Scene.from_dict({k: v for k, v in d.items() if k != "features"})
+        env = scene_domain(s)
+        tol = weak.CONTACT_REL * env.scale
+        pts = np.asarray(shapely.get_coordinates(s.goal_geom))[:4]
+        # and the target's reference point put so that a vertex of it lands near a corner
+        at = env.vert[rng.integers(0, len(env.vert), 4)]
+        r0 = ccw_ring(s.target_at(0.0, 0.0, 0.0), clockwise=True)[0]
+        pts = np.vstack([pts, at - r0])
+        for x, y in pts:
+            for th in (0.0, 0.4):
+                for jit in (0.0, 0.5 * tol, 3 * tol, 40 * tol):
+                    ring = ccw_ring(s.target_at(x, y, th), clockwise=True)
+                    ring = ring + rng.normal(size=2) * jit
+                    wanted = rng.random(len(ring)) < 0.8
+                    got = weak.snap_to_boundary(env, ring, wanted)
+                    monkeypatch.setattr(weak, "_within_reach", whole)
+                    want = weak.snap_to_boundary(env, ring, wanted)
+                    monkeypatch.undo()
+                    assert np.array_equal(got[0], want[0]) and np.array_equal(got[1], want[1])
+                    cases += 1
+                    touched += not np.array_equal(want[0], ring)
+    assert cases > 300 and touched > 100  # contacts were snapped in many of them
