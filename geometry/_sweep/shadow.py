@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from typing import NamedTuple
 
 import numpy as np
 import shapely
@@ -364,6 +365,19 @@ def _ring_coords(rings: list) -> list[np.ndarray]:
     return [xy[a : b - 1] for a, b in zip(at[:-1], at[1:], strict=True)]
 
 
+class _FlatRings(NamedTuple):
+    """Closed rings stored flat: ring ``r`` is ``flat[off[r] : off[r + 1]]``; per vertex its
+    ring (``ring_of``), its successor and predecessor on it (``nxt``, ``prv``), and whether
+    its step to the successor is short (``short``)."""
+
+    flat: np.ndarray
+    off: np.ndarray
+    ring_of: np.ndarray
+    nxt: np.ndarray
+    prv: np.ndarray
+    short: np.ndarray
+
+
 def _drop_short_many(
     rings: list[np.ndarray],
     length: float,
@@ -389,13 +403,12 @@ def _drop_short_many(
         return list(rings)
     prv = np.empty_like(nxt)
     prv[nxt] = idx
-    s, e, tight = _tight_runs(flat, off, ring_of, nxt, prv, short, length)
+    fr = _FlatRings(flat, off, ring_of, nxt, prv, short)
+    s, e, tight = _tight_runs(fr, length)
     out = list(rings)
     batch = np.flatnonzero(any_short & tight)
     if len(batch):
-        got = _drop_tight_runs(
-            flat, off, ring_of, nxt, prv, short, (s, e), batch, length, vertex_at
-        )
+        got = _drop_tight_runs(fr, (s, e), batch, length, vertex_at)
         for k, v in zip(batch.tolist(), got, strict=True):
             out[k] = v
     for k in np.flatnonzero(any_short & ~tight).tolist():
@@ -403,18 +416,9 @@ def _drop_short_many(
     return out
 
 
-def _tight_runs(
-    flat: np.ndarray,
-    off: np.ndarray,
-    ring_of: np.ndarray,
-    nxt: np.ndarray,
-    prv: np.ndarray,
-    short: np.ndarray,
-    length: float,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The runs of short steps of the closed rings ``flat[off[r] : off[r + 1]]`` (``nxt``,
-    ``prv``: each vertex's successor and predecessor on its ring; ``short``: its step to
-    the successor is shorter than ``length``): per run, its first vertex ``s`` and its
+def _tight_runs(fr: _FlatRings, length: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The runs of short steps (shorter than ``length``) of the closed rings ``fr``: per
+    run, its first vertex ``s`` and its
     last ``e`` (the steps ``s .. e - 1`` are short, the step from ``e`` is long), and per
     ring whether all its runs are *tight*: the closing step is long, every vertex of a run
     lies within ``length`` of the run's first and the vertex after it does not, in a ring
@@ -422,6 +426,7 @@ def _tight_runs(
     vertex and the vertices outside the runs (each vertex kept lies at least ``length``
     from the one kept before it, and no kept vertex joins vertex 0's cluster), and its
     clusters are the runs: :func:`_drop_tight_runs` gives what it gives."""
+    flat, off, ring_of, nxt, prv, short = fr
     tight = np.diff(off) >= 4
     if short.all():  # no step is long: no run ends (and no ring is tight)
         return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), tight & False
@@ -443,24 +448,21 @@ def _tight_runs(
 
 
 def _drop_tight_runs(
-    flat: np.ndarray,
-    off: np.ndarray,
-    ring_of: np.ndarray,
-    nxt: np.ndarray,
-    prv: np.ndarray,
-    short: np.ndarray,
+    fr: _FlatRings,
     runs: tuple[np.ndarray, np.ndarray],
     rings: np.ndarray,
     length: float,
     vertex_at: Callable[[np.ndarray], np.ndarray] | None,
 ) -> list[np.ndarray]:
-    """:func:`_drop_short` of the rings ``rings`` (indices; all their runs of short steps
-    tight, :func:`_tight_runs`, whose runs ``(s, e)`` are given) in one batch: per run, its
+    """:func:`_drop_short` of the rings ``rings`` (indices into ``fr``; all their runs of
+    short steps tight, :func:`_tight_runs`, whose runs ``(s, e)`` are given) in one batch:
+    per run, its
     vertices after the first are dropped and the first moved to where the lines of the
     steps entering and leaving the run cross, when that lies within ``4 length`` of it
     (the same floating-point operations as :func:`_corners`); otherwise, where the run
     holds two distinct vertices of the environment (``vertex_at``), the first and the last
     of them are kept, as :func:`_corners` keeps them."""
+    flat, off, ring_of, nxt, prv, short = fr
     want = np.zeros(len(off) - 1, dtype=bool)
     want[rings] = True
     sel = want[ring_of]

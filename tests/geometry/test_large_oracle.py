@@ -206,18 +206,24 @@ def test_compiled_sorted_gaps_equal_numpy():
         assert np.array_equal(x, z)
 
 
-@pytest.mark.skipif(not visindex.available(), reason="numba not installed (fast extra)")
-def test_compiled_sweep_windows_equal_numpy(monkeypatch):
-    """The swept point test's window clipping (visindex.window_ranges) returns exactly what
-    the numpy code of Sweeper._windows returns, on the probes of a real swept query."""
-    from geometry import sweep
-
+def _pentagon_goal_scene() -> dict:
+    """A generated 60-edge scene with a pentagonal goal inside its own (for a swept query)."""
     d = scene_with_edges(60, 1)
     g = shapely.Polygon(d["goal"])
     c = g.representative_point()
     r = 0.8 * g.exterior.distance(c)
     ang = 0.3 + 2 * np.pi * np.arange(5) / 5
     d["goal"] = np.column_stack([c.x + r * np.cos(ang), c.y + r * np.sin(ang)]).tolist()
+    return d
+
+
+@pytest.mark.skipif(not visindex.available(), reason="numba not installed (fast extra)")
+def test_compiled_sweep_windows_equal_numpy(monkeypatch):
+    """The swept point test's window clipping (visindex.window_ranges) returns exactly what
+    the numpy code of Sweeper._windows returns, on the probes of a real swept query."""
+    from geometry import sweep
+
+    d = _pentagon_goal_scene()
     scene = Scene.from_dict(d)
     calls = []
     orig = sweep.Sweeper._windows
@@ -293,12 +299,7 @@ def test_compiled_line_candidates_equal_numpy(monkeypatch):
     from geometry import sweep
     from geometry._sweep import shadow as SH
 
-    d = scene_with_edges(60, 1)
-    g = shapely.Polygon(d["goal"])
-    c = g.representative_point()
-    r = 0.8 * g.exterior.distance(c)
-    ang = 0.3 + 2 * np.pi * np.arange(5) / 5
-    d["goal"] = np.column_stack([c.x + r * np.cos(ang), c.y + r * np.sin(ang)]).tolist()
+    d = _pentagon_goal_scene()
     calls = []
     orig = sweep.Sweeper._label_rows
 
