@@ -418,14 +418,14 @@ def _drop_short_many(
 
 def _tight_runs(fr: _FlatRings, length: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The runs of short steps (shorter than ``length``) of the closed rings ``fr``: per
-    run, its first vertex ``s`` and its
-    last ``e`` (the steps ``s .. e - 1`` are short, the step from ``e`` is long), and per
-    ring whether all its runs are *tight*: the closing step is long, every vertex of a run
-    lies within ``length`` of the run's first and the vertex after it does not, in a ring
-    of at least 4 vertices.  In such a ring :func:`_drop_short` keeps each run's first
-    vertex and the vertices outside the runs (each vertex kept lies at least ``length``
-    from the one kept before it, and no kept vertex joins vertex 0's cluster), and its
-    clusters are the runs: :func:`_drop_tight_runs` gives what it gives."""
+    run, its first vertex ``s`` and its last ``e`` (the steps ``s .. e - 1`` are short, the
+    step from ``e`` is long), and per ring whether all its runs are *tight*: the closing
+    step is long, every vertex of a run lies within ``length`` of the run's first and the
+    vertex after it does not, in a ring of at least 4 vertices.  In such a ring
+    :func:`_drop_short` keeps each run's first vertex and the vertices outside the runs
+    (each vertex kept lies at least ``length`` from the one kept before it, and no kept
+    vertex joins vertex 0's cluster), and its clusters are the runs: :func:`_drop_tight_runs`
+    gives what it gives."""
     flat, off, ring_of, nxt, prv, short = fr
     tight = np.diff(off) >= 4
     if short.all():  # no step is long: no run ends (and no ring is tight)
@@ -456,12 +456,11 @@ def _drop_tight_runs(
 ) -> list[np.ndarray]:
     """:func:`_drop_short` of the rings ``rings`` (indices into ``fr``; all their runs of
     short steps tight, :func:`_tight_runs`, whose runs ``(s, e)`` are given) in one batch:
-    per run, its
-    vertices after the first are dropped and the first moved to where the lines of the
-    steps entering and leaving the run cross, when that lies within ``4 length`` of it
-    (the same floating-point operations as :func:`_corners`); otherwise, where the run
-    holds two distinct vertices of the environment (``vertex_at``), the first and the last
-    of them are kept, as :func:`_corners` keeps them."""
+    per run, its vertices after the first are dropped and the first moved to where the
+    lines of the steps entering and leaving the run cross, when that lies within ``4
+    length`` of it (the same floating-point operations as :func:`_corners`); otherwise,
+    where the run holds two distinct vertices of the environment (``vertex_at``), the
+    first and the last of them are kept, as :func:`_corners` keeps them."""
     flat, off, ring_of, nxt, prv, short = fr
     want = np.zeros(len(off) - 1, dtype=bool)
     want[rings] = True
