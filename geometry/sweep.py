@@ -74,6 +74,7 @@ from ._sweep.events import CollinearityEvents
 from ._sweep.lines import _meet, _rot
 from ._sweep.shadow import StationaryShadows, _rings
 from ._sweep.trace import EdgeTracing
+from ._sweep.wedges import WedgeCover
 from ._vis import Domain
 
 #: The union of the pieces is snap-rounded onto a grid of ``2**-GRID_BITS`` of the scene's
@@ -159,6 +160,9 @@ class _Run:
     ends: tuple[bool, bool] | None = None
     #: the birth check's upper bounds of intervals (a, b) where it found no birth
     bounds: dict[tuple[float, float], shapely.Geometry] = field(default_factory=dict)
+    #: the birth check's upper bounds of all intervals (a, b) it bounded, births found or
+    #: not (:meth:`Sweeper._wedge_covered`)
+    uppers: dict[tuple[float, float], shapely.Geometry] = field(default_factory=dict)
     #: per interval (a, b) tested: is it closed (:meth:`closes`; closed: its samples'
     #: shadows hold every shadow in between, nothing to trace or sample there)
     closed: dict[tuple[float, float], bool] = field(default_factory=dict)
@@ -196,7 +200,13 @@ class _Run:
             self.ev_side,
             self.closes,
             self.ends_clear,
+            self.wedge_covered,
         )
+
+    def wedge_covered(self, k: int, side: int, lo: float, hi: float) -> bool:
+        """Whether event ``k`` needs no sample in the interval ``(lo, hi)`` on its ``side``
+        (:meth:`Sweeper._wedge_covered`)."""
+        return self.sw._wedge_covered(self, k, side, lo, hi)
 
     def ends_clear(self, end: int) -> bool:
         """Whether the sample at time ``end`` (0 or 1) stands in for the event samples of
@@ -226,7 +236,15 @@ class _Run:
 
 
 @dataclass
-class Sweeper(StationaryShadows, PointTest, CollinearityEvents, Coverage, BirthChecks, EdgeTracing):
+class Sweeper(
+    StationaryShadows,
+    PointTest,
+    CollinearityEvents,
+    WedgeCover,
+    Coverage,
+    BirthChecks,
+    EdgeTracing,
+):
     """Swept shadows of one target (fixed orientation) moving along segments.
 
     Parameters
@@ -245,7 +263,8 @@ class Sweeper(StationaryShadows, PointTest, CollinearityEvents, Coverage, BirthC
     Its parts live in :mod:`geometry._sweep`, one mixin each: the samples' stationary
     shadows (:class:`~geometry._sweep.shadow.StationaryShadows`), the exact point test
     (:class:`~geometry._sweep.blind.PointTest`), the collinearity events
-    (:class:`~geometry._sweep.events.CollinearityEvents`), the coverage decisions
+    (:class:`~geometry._sweep.events.CollinearityEvents`) and the wedges they need not sample
+    (:class:`~geometry._sweep.wedges.WedgeCover`), the coverage decisions
     (:class:`~geometry._sweep.cover.Coverage`), the birth checks
     (:class:`~geometry._sweep.births.BirthChecks`) and the edge tracing
     (:class:`~geometry._sweep.trace.EdgeTracing`); this class holds the state and runs

@@ -66,6 +66,7 @@ class BirthChecks:
                     # no eroded target: bisect where one exists within the depth limit
                     new = self._core_within_depth(b - a, depth, r.dq)
                 else:
+                    r.uppers[(a, b)] = upper  # for _wedge_covered, alarmed or not
                     born = self._born(upper, r.frame(a)[0], r.frame(b)[0])
                     new = len(born) > 0
                     if new and i not in split and self._halves_checked(r, a, b, depth):

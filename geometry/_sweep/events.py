@@ -69,6 +69,7 @@ class CollinearityEvents:
         ev_side: list | None = None,
         closes: Callable[[float, float], bool] | None = None,
         ends: Callable[[int], bool] | None = None,
+        covered: Callable[[int, int, float, float], bool] | None = None,
     ) -> list[float]:
         """The sample times (sorted, not sampled yet) that the collinearity events
         :meth:`_events` asks for now: the midpoint of each interval between consecutive
@@ -92,7 +93,9 @@ class CollinearityEvents:
         ``closes(a, b)`` (:meth:`~geometry._sweep.births.BirthChecks._closes`: its two samples'
         shadows hold every shadow in between, the wedge's too).  Nor inside the first (last)
         interval between events where ``ends(0)`` (``ends(1)``) holds: the sample at 0 (1)
-        stands in for it (:meth:`_ends_clear`)."""
+        stands in for it (:meth:`_ends_clear`).  Nor for a side of an event where
+        ``covered(event, side, lo, hi)`` holds (:meth:`_wedge_covered`: the two samples'
+        shadows already hold every wedge it can open there)."""
         bounds = np.concatenate([[0.0], ev_t, [1.0]])
         if not self.lazy_samples:  # the previous rule: once between every two events, at once
             if looked:
@@ -122,6 +125,8 @@ class CollinearityEvents:
                     b == end and end in frames and ends(int(end))
                     for b, end in ((lo, 0.0), (hi, 1.0))
                 ):
+                    continue
+                if covered is not None and covered(k, side, float(lo), float(hi)):
                     continue
                 out.add(float(0.5 * (lo + hi)))
         return sorted(out)
