@@ -35,8 +35,9 @@ class WedgeCover:
         between the two lines through it: the event line itself and the line from the
         moving anchor to the corner (for the line of two target vertices through a corner
         b, the lines from both vertices to b).  Those lines change only at an event that
-        involves the corner (the moving line passing another corner, or the target's
-        tangent vertex handing over to the next); with none in the wedge's life within
+        involves the corner and the moving anchor (the moving line passing another corner,
+        or the target's tangent vertex handing over to another, both of them on a line
+        through the corner); with none in the wedge's life within
         ``(a, b)``, namely ``(t_e, b)`` after the event or ``(a, t_e)`` before it, the wedge
         stays in the cone at the corner swept by the moving line over that life
         (:meth:`_wedge_cone`; the moving anchors run on straight lines, so each line turns
@@ -64,9 +65,13 @@ class WedgeCover:
         corners = {c for _, other in r.ev_ids[k] for c in other}
         if -1 in corners:  # an obstacle edge's end not known: no cone
             return False
+        moving = {m for mov, _ in r.ev_ids[k] for m in mov}
         for j, t in enumerate(r.ev_t):
             if j != k and life[0] < t < life[1]:
-                if any(corners.intersection(other) for _, other in r.ev_ids[j]):
+                # the wedge's lines change at an event of one of its corners and one of its
+                # moving anchors: the anchor's line passing another corner, or the tangent
+                # vertex handing over (another vertex's event at the corner moves other lines)
+                if any(corners & set(other) and moving & set(mov) for mov, other in r.ev_ids[j]):
                     return False
         cone = self._wedge_cone(r, r.ev_ids[k], life)
         if cone is None:

@@ -561,7 +561,10 @@ def test_a_room_corner_event_samples_only_the_side_where_x_is_behind_the_wall(
     sweep away from each such event, at the point p on the free side of the edge's middle,
     halfway between the edge and the line from x through b_n: on the side not sampled p sees
     x, on the side sampled it is blind to x; and the regions (swept and 5.2) are those that
-    sampling both sides of such events gives, with fewer samples on ``willow_south``."""
+    sampling both sides of such events gives, with fewer samples on ``willow_south``.  The
+    wedge rule (:meth:`~geometry._sweep.wedges.WedgeCover._wedge_covered`) is off in both
+    runs: it can leave out the same samples, which is that rule's business."""
+    monkeypatch.setattr(S._Run, "wedge_covered", lambda self, *a: False)
     got, made, seen = _run_seeing_events(name, monkeypatch)
     checked = checked_52 = 0
     for sw, q0, dq, t, (mov, other), sides in seen:
@@ -716,7 +719,11 @@ def test_a_continuation_sample_is_taken_only_where_the_cut_line_bounds_the_shado
     along the boundary.  ``willow_south`` passes over some (not vacuous), ``willow_north``
     keeps one.  With the previous rule (every confirmed twentieth sampled) the 5.2 regions
     are within the same bounds as the other lazy rules' (:func:`_assert_close`), with more
-    samples on ``willow_south`` and the fuzz scene."""
+    samples on ``willow_south`` and the fuzz scene.  The wedge rule
+    (:meth:`~geometry._sweep.wedges.WedgeCover._wedge_covered`) is off: on ``willow_north``
+    the cut edge whose continuation is kept lies in an interval that an event sample it
+    leaves out would have split."""
+    monkeypatch.setattr(S._Run, "wedge_covered", lambda self, *a: False)
     seen: list[tuple] = []
     orig = S.Sweeper._line_bounds
 
@@ -780,7 +787,10 @@ def test_an_interval_whose_bound_lies_in_its_samples_shadows_takes_no_event_samp
     sweeps an interval closes only where no overlap strip comes near the target's edges
     (:meth:`~geometry._sweep.births.BirthChecks._strips_miss`; on ``willow_north`` G and H are
     apart).  Without the rule the regions are within the bounds of the other lazy rules
-    (:func:`_assert_close`) and take more samples."""
+    (:func:`_assert_close`) and take more samples.  The wedge rule
+    (:meth:`~geometry._sweep.wedges.WedgeCover._wedge_covered`) is off in both runs: it can
+    leave out the same event samples, which is that rule's business."""
+    monkeypatch.setattr(S._Run, "wedge_covered", lambda self, *a: False)
     got, asked = _query_spying(name, query, "closes", monkeypatch)
     closed = {(id(r), a, b): (r, a, b) for r, a, b, ok in asked if ok}
     assert closed
