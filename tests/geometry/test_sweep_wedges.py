@@ -118,3 +118,38 @@ def _wide_depth(a: shapely.Geometry, b: shapely.Geometry, eps: float) -> float:
     parts = parts[2.0 * shapely.area(parts) > eps * shapely.length(parts)]
     pts = shapely.get_coordinates(parts)
     return float(shapely.distance(b, shapely.points(pts)).max()) if len(pts) else 0.0
+
+
+def test_an_event_of_other_anchors_at_a_corner_keeps_no_sample(monkeypatch) -> None:
+    """The wedge rule keeps an event's sample for another event in the wedge's life only where
+    that event involves one of its corners *and* one of its moving anchors (the anchor's line
+    passing another corner, or the tangent vertex handing over): those are what move the
+    wedge's lines.  On ``willow_north``'s swept query a sample is left out whose wedge's life
+    holds an event of one of its corners with other moving anchors only (the tangent on the
+    corner's other side handing over between two other target vertices), so the narrower
+    guard is what decides there (not vacuous); that the samples left out add nothing is
+    :func:`test_a_sample_left_out_would_have_added_nothing`."""
+    others: list[int] = []
+    orig = S._Run.wedge_covered
+
+    def spy(self, k, side, lo, hi):
+        got = orig(self, k, side, lo, hi)
+        if got:
+            times = np.array(sorted(self.frames))
+            a, b = float(times[times <= lo][-1]), float(times[times >= hi][0])
+            t_e = float(self.ev_t[k])
+            life = (t_e, b) if side > 0 else (a, t_e)
+            corners = {c for _, other in self.ev_ids[k] for c in other}
+            moving = {m for mov, _ in self.ev_ids[k] for m in mov}
+            others.extend(
+                j
+                for j, t in enumerate(self.ev_t)
+                if j != k
+                and life[0] < t < life[1]
+                and any(corners & set(o) and not moving & set(m) for m, o in self.ev_ids[j])
+            )
+        return got
+
+    monkeypatch.setattr(S._Run, "wedge_covered", spy)
+    _with_rule(True, lambda: _query("real/willow_north", "swept"), monkeypatch)
+    assert others
