@@ -65,14 +65,8 @@ class WedgeCover:
         corners = {c for _, other in r.ev_ids[k] for c in other}
         if -1 in corners:  # an obstacle edge's end not known: no cone
             return False
-        moving = {m for mov, _ in r.ev_ids[k] for m in mov}
-        for j, t in enumerate(r.ev_t):
-            if j != k and life[0] < t < life[1]:
-                # the wedge's lines change at an event of one of its corners and one of its
-                # moving anchors: the anchor's line passing another corner, or the tangent
-                # vertex handing over (another vertex's event at the corner moves other lines)
-                if any(corners & set(other) and moving & set(mov) for mov, other in r.ev_ids[j]):
-                    return False
+        if self._wedge_moved(r, k, life):
+            return False
         cone = self._wedge_cone(r, r.ev_ids[k], life)
         if cone is None:
             return False
@@ -87,6 +81,23 @@ class WedgeCover:
         )
         parts = shapely.get_parts(rest)
         return not (2.0 * shapely.area(parts) > g * shapely.length(parts)).any()
+
+    def _wedge_moved(self, r, k: int, life: tuple[float, float]) -> bool:
+        """Whether an event of the run ``r`` strictly inside ``life`` moves the lines of event
+        ``k``'s wedge: an event of one of its corners and one of its moving anchors (the
+        anchor's line passing another corner, or the tangent vertex handing over; another
+        vertex's event at the corner moves other lines).  At either corner of an event line:
+        the wedge is beyond the farther one, but the anchor's line through the nearer one
+        passing another corner moves it too (fuzz seed 201224, 5.2;
+        ``tests/geometry/test_sweep_wedges.py``)."""
+        corners = {c for _, other in r.ev_ids[k] for c in other}
+        moving = {m for mov, _ in r.ev_ids[k] for m in mov}
+        return any(
+            corners & set(other) and moving & set(mov)
+            for j, t in enumerate(r.ev_t)
+            if j != k and life[0] < t < life[1]
+            for mov, other in r.ev_ids[j]
+        )
 
     def _wedge_cone(self, r, ids: list, life: tuple[float, float]) -> shapely.Geometry | None:
         """The cones (:func:`_cone`) of an event's anchor tuples ``ids`` ((moving ids, other

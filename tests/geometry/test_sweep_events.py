@@ -662,7 +662,11 @@ def test_a_birth_alarm_whose_bisection_would_find_nothing_takes_no_sample(
 def _seen_along_g(name: str, sw: S.Sweeper, added: shapely.Geometry) -> None:
     """Every placement of ``added`` (a region's part that a rule adds: its vertices and random
     interior points) sees the target at configurations densely spaced on the boundary of G
-    (301 per edge; the exact point test of the sweeper ``sw`` of scene ``name``)."""
+    (301 per edge; the exact point test of the sweeper ``sw`` of scene ``name``, which works
+    in the scene's local frame: ``added``, in the world frame, is mapped there)."""
+    scene = _scene(name)
+    fr = scene.frame
+    added = shapely.transform(added, lambda xy: (xy - [fr.ox, fr.oy]) / fr.scale)
     pts = shapely.get_coordinates(added)
     if len(pts) == 0:
         return
@@ -670,10 +674,13 @@ def _seen_along_g(name: str, sw: S.Sweeper, added: shapely.Geometry) -> None:
     x0, y0, x1, y1 = added.bounds
     inner = np.column_stack([rng.uniform(x0, x1, 2000), rng.uniform(y0, y1, 2000)])
     pts = np.vstack([pts, inner[shapely.contains_xy(added, inner[:, 0], inner[:, 1])]])
-    scene = _scene(name)
+    # in the free space of the sweeper's map but for rounding (off it the point test says
+    # "not blind": in the wrong frame this check would pass for nothing)
+    assert (shapely.distance(sw.free, shapely.points(pts)) <= 1e-9 * sw.env.scale).all(), name
     # the sweeper's frame: reference point moved into the target's kernel
-    c = S.star_center(ccw_ring(scene.target_at(0.0, 0.0, 0.0)))
-    ring = np.asarray(scene.goal_geom.exterior.coords)[:, :2] + c
+    local = scene.local
+    c = S.star_center(ccw_ring(local.target_at(0.0, 0.0, 0.0)))
+    ring = np.asarray(local.goal_geom.exterior.coords)[:, :2] + c
     for a, b in zip(ring[:-1], ring[1:], strict=True):
         for t in np.linspace(0.0, 1.0, 301):
             q = np.repeat((a + t * (b - a))[None], len(pts), axis=0)

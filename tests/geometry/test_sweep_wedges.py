@@ -55,6 +55,7 @@ def test_the_tightest_bound_holding_the_interval() -> None:
         ("fuzz:200011", "swept"),
         ("fuzz:200017", "swept"),
         ("fuzz:200238", "swept"),
+        ("fuzz:200177", "swept"),
         ("fuzz:200148", "recognizable"),
     ],
 )
@@ -153,3 +154,74 @@ def test_an_event_of_other_anchors_at_a_corner_keeps_no_sample(monkeypatch) -> N
     monkeypatch.setattr(S._Run, "wedge_covered", spy)
     _with_rule(True, lambda: _query("real/willow_north", "swept"), monkeypatch)
     assert others
+
+
+def _far_corner_only(self, r, k, life) -> bool:
+    """:meth:`~geometry._sweep.wedges.WedgeCover._wedge_moved` counting, for a moving anchor
+    on the line of two corners, only the events at the corner farther from it at the event's
+    time (where the wedge lies) and not those at the nearer one: a refinement measured and
+    refuted (see the test below)."""
+    t_e = float(r.ev_t[k])
+    q = (r.q0 + t_e * r.dq)[None, :]
+    corners = set()
+    for mov, other in r.ev_ids[k]:
+        if len(mov) == 1 and len(other) == 2:
+            d = np.hypot(*(self.env.vert[list(other)] - self.pos(np.array(mov), q)).T)
+            corners.add(other[int(np.argmax(d))])
+        else:
+            corners.update(other)
+    moving = {m for mov, _ in r.ev_ids[k] for m in mov}
+    return any(
+        corners & set(other) and moving & set(mov)
+        for j, t in enumerate(r.ev_t)
+        if j != k and life[0] < t < life[1]
+        for mov, other in r.ev_ids[j]
+    )
+
+
+@pytest.mark.parametrize(
+    ("name", "query"), [("fuzz:200177", "swept"), ("fuzz:201224", "recognizable")]
+)
+def test_events_at_the_nearer_corner_keep_the_sample(name, query, monkeypatch) -> None:
+    """The wedge of a moving anchor on the line of two corners lies beyond the farther one,
+    yet events at the nearer corner move it too: a guard that looks at the farther corner only
+    (:func:`_far_corner_only`) leaves out samples whose shadow has a part wider than rounding
+    outside the union: on fuzz seed 200177 past the tangent vertex handing over at the nearer
+    corner, on seed 201224 (5.2) past the anchor's line through the nearer corner passing
+    another corner, as on ``willow_north`` (where that refinement would leave out the swept
+    query's last two event samples).  The guard at both corners
+    (:meth:`~geometry._sweep.wedges.WedgeCover._wedge_moved`) keeps them."""
+    orig_covered, orig_union = S._Run.wedge_covered, S._union_pieces
+
+    def widest_left_out(moved) -> float:
+        """The widest part (twice its area over its perimeter, in units of the scene's
+        size) of a left-out sample's shadow outside its sweep's union."""
+        skipped: list[tuple] = []
+        unions: dict[int, shapely.Geometry] = {}
+
+        def spy(self, k, side, lo, hi):
+            got = orig_covered(self, k, side, lo, hi)
+            if got:
+                skipped.append((self.sw, self.q0 + 0.5 * (lo + hi) * self.dq))
+            return got
+
+        def union(sw, pieces):
+            unions[id(sw)] = got = orig_union(sw, pieces)
+            return got
+
+        with monkeypatch.context() as m:
+            m.setattr(S._Run, "wedge_covered", spy)
+            m.setattr(S, "_union_pieces", union)
+            m.setattr(W.WedgeCover, "_wedge_moved", moved)
+            _with_rule(True, lambda: _query(name, query), monkeypatch)
+        assert skipped  # not vacuous
+        widest = 0.0
+        for sw, qm in skipped:
+            rest = shapely.get_parts(shapely.difference(sw.shadow(qm)[0], unions[id(sw)]))
+            if len(rest):
+                w = 2.0 * shapely.area(rest) / np.maximum(shapely.length(rest), 1e-300)
+                widest = max(widest, float(w.max()) / sw.env.scale)
+        return widest
+
+    assert widest_left_out(W.WedgeCover._wedge_moved) <= 1e-9
+    assert widest_left_out(_far_corner_only) > 1e-8
