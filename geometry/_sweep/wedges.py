@@ -90,14 +90,7 @@ class WedgeCover:
         the wedge is beyond the farther one, but the anchor's line through the nearer one
         passing another corner moves it too (fuzz seed 201224, 5.2;
         ``tests/geometry/test_sweep_wedges.py``)."""
-        corners = {c for _, other in r.ev_ids[k] for c in other}
-        moving = {m for mov, _ in r.ev_ids[k] for m in mov}
-        return any(
-            corners & set(other) and moving & set(mov)
-            for j, t in enumerate(r.ev_t)
-            if j != k and life[0] < t < life[1]
-            for mov, other in r.ev_ids[j]
-        )
+        return _moved_at(r, k, life, {c for _, other in r.ev_ids[k] for c in other})
 
     def _wedge_cone(self, r, ids: list, life: tuple[float, float]) -> shapely.Geometry | None:
         """The cones (:func:`_cone`) of an event's anchor tuples ``ids`` ((moving ids, other
@@ -119,6 +112,18 @@ class WedgeCover:
                     return None
                 cones.append(got)
         return shapely.union_all(cones) if cones else None
+
+
+def _moved_at(r, k: int, life: tuple[float, float], corners: set) -> bool:
+    """Whether an event of the run ``r`` strictly inside ``life`` involves one of
+    ``corners`` and one of the moving anchors of event ``k``."""
+    moving = {m for mov, _ in r.ev_ids[k] for m in mov}
+    return any(
+        corners & set(other) and moving & set(mov)
+        for j, t in enumerate(r.ev_t)
+        if j != k and life[0] < t < life[1]
+        for mov, other in r.ev_ids[j]
+    )
 
 
 def _tightest(uppers: dict, a: float, b: float) -> shapely.Geometry | None:
