@@ -15,6 +15,15 @@ import shapely
 
 from .._shapes import areal, snapped
 
+#: Whether :meth:`WedgeCover._wedge_covered` may leave samples out (off: docs/DESIGN.md,
+#: "Event samples whose wedge the samples already hold").  The rule is right about the
+#: event's wedge, but an event sample also catches what else is born in its interval, and
+#: a shadow born across an edge the tracing does not follow is caught by no other rule: on
+#: fuzz seed 202333 (mixed 5.2) leaving one such sample out put placements 10 ``tol`` deep
+#: in the conservative region that see nothing of the target at a configuration of H
+#: (``tests/geometry/test_swept_births.py``).
+WEDGE_RULE = False
+
 #: Points on the arc of a wedge's cone (:func:`_cone`): the polygon's chords then stay
 #: within ``1 - cos(pi / 16) < 2 %`` of its radius, which is four times the scene's size.
 CONE_ARC = 9
@@ -50,7 +59,7 @@ class WedgeCover:
         along an obstacle edge, beyond the nearer one).  With overlap strips (5.2) the
         bound holds the full target's shadows only: as in :meth:`_closes`, only where no
         strip comes near (:meth:`_strips_miss`)."""
-        if not self.lazy_samples:
+        if not (self.lazy_samples and WEDGE_RULE):
             return False
         times = np.array(sorted(r.frames))
         before, after = times[times <= lo], times[times >= hi]

@@ -19,6 +19,13 @@ from geometry._sweep import wedges as W
 from tests.geometry.test_sweep_events import _query, _scene, _seen_along_g, _with_rule
 
 
+@pytest.fixture(autouse=True)
+def _wedge_rule_on(monkeypatch) -> None:
+    """The rule is off by default (:data:`geometry._sweep.wedges.WEDGE_RULE`); these tests
+    check it as it would run."""
+    monkeypatch.setattr(W, "WEDGE_RULE", True)
+
+
 def test_cone_spans_the_directions_and_no_more() -> None:
     apex = np.array([1.0, 2.0])
     dirs = np.array([[1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
