@@ -60,6 +60,7 @@ NAMES = (
     "navigate_hint",
     "recognize_hint",
     "recognize_dagger",
+    "sweep_audit",
 )
 
 

@@ -17,9 +17,9 @@ import numpy as np
 import pytest
 import shapely
 
+from benchmarks.sweep_audit import widest_miss
 from geometry import recognizable_region
-from geometry import sweep as S
-from tests.geometry.test_sweep_events import _query, _scene
+from tests.geometry.test_sweep_events import _scene
 
 #: fuzz seed 202333: a placement (world frame) inside the spike, and the configuration on the
 #: boundary of H (the point at 0.8 of its second edge) where it sees nothing of the target
@@ -57,38 +57,6 @@ def test_the_conservative_region_leaves_the_spike_out() -> None:
     assert not shapely.intersects(got, shapely.Point(SPIKE))
 
 
-def _dense_misses(name: str, query: str, monkeypatch, n_t: int = 41) -> float:
-    """The widest part (twice its area over its perimeter, in units of the scene's size) of
-    a shadow S(t), at ``n_t`` times along every segment of every sweep of the query, outside
-    that sweep's union."""
-    segs: list[tuple] = []
-    unions: dict[int, shapely.Geometry] = {}
-    along, union = S.Sweeper.along_many, S._union_pieces
-
-    def spy(self, pairs, *rest):
-        segs.extend((self, np.asarray(a, float), np.asarray(b, float)) for a, b in pairs)
-        return along(self, pairs, *rest)
-
-    def keep(sw, pieces):
-        unions[id(sw)] = got = union(sw, pieces)
-        return got
-
-    with monkeypatch.context() as m:
-        m.setattr(S.Sweeper, "along_many", spy)
-        m.setattr(S, "_union_pieces", keep)
-        _query(name, query, conservative=False)
-    widest = 0.0
-    for sw, a, b in segs:
-        u = unions[id(sw)]
-        shapely.prepare(u)
-        for t in np.linspace(0.0, 1.0, n_t):
-            rest = shapely.get_parts(shapely.difference(sw.shadow(a + t * (b - a))[0], u))
-            if len(rest):
-                w = 2.0 * shapely.area(rest) / np.maximum(shapely.length(rest), 1e-300)
-                widest = max(widest, float(w.max()) / sw.env.scale)
-    return widest
-
-
 @pytest.mark.parametrize(
     ("name", "query"),
     [
@@ -98,8 +66,9 @@ def _dense_misses(name: str, query: str, monkeypatch, n_t: int = 41) -> float:
         ("fuzz:200049", "recognizable"),
     ],
 )
-def test_every_shadow_at_dense_times_lies_in_the_union(name, query, monkeypatch) -> None:
+def test_every_shadow_at_dense_times_lies_in_the_union(name, query) -> None:
     """At 41 times along every segment of every sweep, the exact stationary shadow lies in
     the sweep's union but for parts narrower than ``tol`` (1e-4 of the scene: the traces'
-    chords); the spike of seed 202333 was 16 ``tol`` wide."""
-    assert _dense_misses(name, query, monkeypatch) <= 1e-4
+    chords; :func:`benchmarks.sweep_audit.widest_miss`); the spike of seed 202333 was 16
+    ``tol`` wide."""
+    assert widest_miss(_scene(name), query, 41) <= 1e-4
