@@ -5,7 +5,8 @@ the wedge that can open there (:mod:`.events`).  The wedge lies beyond a corner 
 between the two lines through that corner (docs/DESIGN.md, "The sides of an event where its
 wedge can be blind"), and it lies in every shadow bound of its interval; where the part of
 that cone inside the bound is already held by the two samples' shadows, the sample can add
-nothing to the union.  Part of :class:`geometry.sweep.Sweeper`.
+nothing to the union.  Part of :class:`geometry.sweep.Sweeper`.  Off (:data:`WEDGE_RULE`):
+the sample it leaves out can be the only one to catch a shadow born elsewhere in its interval.
 """
 
 from __future__ import annotations
