@@ -84,8 +84,10 @@ def _seeds(arg: tuple[int, int, int]) -> list[dict[str, Any]]:
     seed, n, n_t = arg
     rows = []
     for s in range(seed, seed + n):
+        d = fuzz_scene(s, contacts=True)  # None: no valid scene from this seed
+        if d is None:
+            continue
         try:
-            d = fuzz_scene(s, contacts=True)
             scene = Scene.from_dict({k: v for k, v in d.items() if k != "features"})
         except (SceneError, ValueError):
             continue
@@ -94,8 +96,12 @@ def _seeds(arg: tuple[int, int, int]) -> list[dict[str, Any]]:
             queries.append("recognizable")
         for q in queries:
             t0 = time.perf_counter()
-            w = widest_miss(scene, q, n_t)
-            rows.append({"seed": s, "query": q, "widest": w, "seconds": time.perf_counter() - t0})
+            row: dict[str, Any] = {"seed": s, "query": q}
+            try:
+                row["widest"] = widest_miss(scene, q, n_t)
+            except Exception as e:  # a query that fails is a finding too: kept, not fatal
+                row["widest"], row["error"] = None, f"{type(e).__name__}: {e}"
+            rows.append({**row, "seconds": time.perf_counter() - t0})
     return rows
 
 
@@ -135,6 +141,7 @@ def render(data: dict[str, Any]) -> str:
     width class, and the queries whose miss is wider than ``tol`` (1e-4 of the scene)."""
     a, b = data["seeds"]
     rows = data["rows"]
+    ok = [r for r in rows if r["widest"] is not None]
     heads = [f"≤ {c:g}" for c in CLASSES] + [f"> {CLASSES[-1]:g}"]
     out = [
         f"Seeds {a}-{b} of the swept fuzz's scenes, {len(rows)} queries, the exact shadow at "
@@ -145,10 +152,10 @@ def render(data: dict[str, Any]) -> str:
         "|---|---:|" + "---:|" * len(heads),
     ]
     for q in ("swept", "recognizable"):
-        ws = np.array([r["widest"] for r in rows if r["query"] == q])
+        ws = np.array([r["widest"] for r in ok if r["query"] == q])
         counts = np.bincount(np.searchsorted(CLASSES, ws), minlength=len(heads))
         out.append(f"| {q} | {len(ws)} | " + " | ".join(map(str, counts)) + " |")
-    wide = sorted((r for r in rows if r["widest"] > CLASSES[-1]), key=lambda r: -r["widest"])
+    wide = sorted((r for r in ok if r["widest"] > CLASSES[-1]), key=lambda r: -r["widest"])
     out.append("")
     if wide:
         out.append(
@@ -158,6 +165,13 @@ def render(data: dict[str, Any]) -> str:
         )
     else:
         out.append("No miss wider than `tol`.")
+    failed = [r for r in rows if r["widest"] is None]
+    if failed:
+        out.append(
+            "Queries that failed: "
+            + ", ".join(f"seed {r['seed']} {r['query']} ({r['error']})" for r in failed)
+            + "."
+        )
     secs = sum(r["seconds"] for r in rows)
     out.append(f"\n{secs / 3600.0:.2f} process-hours.")
     return "\n".join(out) + "\n"

@@ -27,3 +27,7 @@ def test_runs_and_renders(tmp_path):
     assert "| recognizable | 1 |" in md and "No miss wider than `tol`." in md
     data["rows"].append({"seed": 1, "query": "swept", "widest": 2e-3, "seconds": 0.0})
     assert "Wider than `tol`: seed 1 swept (0.002)." in sweep_audit.render(data)
+    data["rows"].append(
+        {"seed": 2, "query": "swept", "widest": None, "error": "E: x", "seconds": 0.0}
+    )
+    assert "Queries that failed: seed 2 swept (E: x)." in sweep_audit.render(data)
