@@ -131,31 +131,54 @@ def main(argv: list[str] | None = None) -> None:
         "machine": _results.machine(),
         "seeds": [args.seed, args.seed + args.n - 1],
         "times": args.times,
-        "rows": rows,
+        **summarize(rows),
     }
     _results.write("sweep_audit", data, args.out, args.update_results)
+
+
+def summarize(rows: list[dict[str, Any]]) -> dict[str, Any]:
+    """The audit's rows (one per query: ``seed``, ``query``, ``widest`` or None and
+    ``error``, ``seconds``) as tracked: per query kind the number audited and the counts per
+    width class (:data:`CLASSES`, then wider), the rows wider than 1e-6 of the scene and
+    those that failed (seed, query, widest to three digits), and the process-seconds."""
+    ok = [r for r in rows if r["widest"] is not None]
+    counts = {}
+    for q in ("swept", "recognizable"):
+        ws = np.array([r["widest"] for r in ok if r["query"] == q])
+        counts[q] = np.bincount(np.searchsorted(CLASSES, ws), minlength=len(CLASSES) + 1)
+    return {
+        "queries": len(rows),
+        "counts": {q: [int(c) for c in v] for q, v in counts.items()},
+        "misses": [
+            {"seed": r["seed"], "query": r["query"], "widest": float(f"{r['widest']:.3g}")}
+            for r in sorted(ok, key=lambda r: -r["widest"])
+            if r["widest"] > CLASSES[1]
+        ],
+        "failed": [
+            {"seed": r["seed"], "query": r["query"], "error": r["error"]}
+            for r in rows
+            if r["widest"] is None
+        ],
+        "seconds": round(sum(r["seconds"] for r in rows), 1),
+    }
 
 
 def render(data: dict[str, Any]) -> str:
     """The page fragment: per query, how many audits found their widest missed part in each
     width class, and the queries whose miss is wider than ``tol`` (1e-4 of the scene)."""
     a, b = data["seeds"]
-    rows = data["rows"]
-    ok = [r for r in rows if r["widest"] is not None]
     heads = [f"≤ {c:g}" for c in CLASSES] + [f"> {CLASSES[-1]:g}"]
     out = [
-        f"Seeds {a}-{b} of the swept fuzz's scenes, {len(rows)} queries, the exact shadow at "
-        f"{data['times']} configurations along every segment of every sweep; the widest part "
+        f"Seeds {a}-{b} of the swept fuzz's scenes, {data['queries']} queries, the exact shadow "
+        f"at {data['times']} configurations along every segment of every sweep; the widest part "
         "outside the sweep's union, in units of the scene's size (`tol` is 1e-4):",
         "",
         "| query | audited | " + " | ".join(heads) + " |",
         "|---|---:|" + "---:|" * len(heads),
     ]
-    for q in ("swept", "recognizable"):
-        ws = np.array([r["widest"] for r in ok if r["query"] == q])
-        counts = np.bincount(np.searchsorted(CLASSES, ws), minlength=len(heads))
-        out.append(f"| {q} | {len(ws)} | " + " | ".join(map(str, counts)) + " |")
-    wide = sorted((r for r in ok if r["widest"] > CLASSES[-1]), key=lambda r: -r["widest"])
+    for q, counts in data["counts"].items():
+        out.append(f"| {q} | {sum(counts)} | " + " | ".join(map(str, counts)) + " |")
+    wide = [r for r in data["misses"] if r["widest"] > CLASSES[-1]]
     out.append("")
     if wide:
         out.append(
@@ -165,15 +188,13 @@ def render(data: dict[str, Any]) -> str:
         )
     else:
         out.append("No miss wider than `tol`.")
-    failed = [r for r in rows if r["widest"] is None]
-    if failed:
+    if data["failed"]:
         out.append(
             "Queries that failed: "
-            + ", ".join(f"seed {r['seed']} {r['query']} ({r['error']})" for r in failed)
+            + ", ".join(f"seed {r['seed']} {r['query']} ({r['error']})" for r in data["failed"])
             + "."
         )
-    secs = sum(r["seconds"] for r in rows)
-    out.append(f"\n{secs / 3600.0:.2f} process-hours.")
+    out.append(f"\n{data['seconds'] / 3600.0:.2f} process-hours.")
     return "\n".join(out) + "\n"
 
 

@@ -21,13 +21,22 @@ def test_runs_and_renders(tmp_path):
     sweep_audit.main(["--n", "2", "--seed", "202333", "--times", "9", "--out", str(tmp_path)])
     data = json.loads((tmp_path / "sweep_audit.json").read_text())
     assert data["seeds"] == [202333, 202334] and data["times"] == 9
-    assert {r["query"] for r in data["rows"]} == {"swept", "recognizable"}
+    assert data["queries"] == 3 and sum(data["counts"]["recognizable"]) == 1
     md = (tmp_path / "sweep_audit.md").read_text()
     assert md == sweep_audit.render(data)
     assert "| recognizable | 1 |" in md and "No miss wider than `tol`." in md
-    data["rows"].append({"seed": 1, "query": "swept", "widest": 2e-3, "seconds": 0.0})
-    assert "Wider than `tol`: seed 1 swept (0.002)." in sweep_audit.render(data)
-    data["rows"].append(
-        {"seed": 2, "query": "swept", "widest": None, "error": "E: x", "seconds": 0.0}
-    )
-    assert "Queries that failed: seed 2 swept (E: x)." in sweep_audit.render(data)
+
+
+def test_summary_keeps_the_misses_and_the_failures():
+    rows = [
+        {"seed": 1, "query": "swept", "widest": 2e-3, "seconds": 1.0},
+        {"seed": 2, "query": "swept", "widest": 1e-9, "seconds": 1.0},
+        {"seed": 3, "query": "recognizable", "widest": 5e-5, "seconds": 1.0},
+        {"seed": 4, "query": "swept", "widest": None, "error": "E: x", "seconds": 1.5},
+    ]
+    data = {"seeds": [1, 4], "times": 41, **sweep_audit.summarize(rows)}
+    assert data["counts"] == {"swept": [1, 0, 0, 0, 1], "recognizable": [0, 0, 0, 1, 0]}
+    assert [r["seed"] for r in data["misses"]] == [1, 3] and data["seconds"] == 4.5
+    md = sweep_audit.render(data)
+    assert "Wider than `tol`: seed 1 swept (0.002)." in md
+    assert "Queries that failed: seed 4 swept (E: x)." in md

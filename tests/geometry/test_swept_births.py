@@ -8,7 +8,12 @@ across an edge that the tracing does not follow (its sweep stays inside the two 
 shadows) and attached to the shadows, so the birth checks do not see it either.  The wedge rule
 (:mod:`geometry._sweep.wedges`) left out the event sample that had caught it, and the
 conservative region then held placements 10 ``tol`` deep that see nothing of the target at a
-configuration on the boundary of H (CGAL's visibility polygon, below).
+configuration on the boundary of H (CGAL's visibility polygon, below).  On seed 201693 (G and
+H polygons) the sweep misses such a spike with the wedge rule off too: the other rules that
+thin the samples leave none inside its life (the previous, eager rules have one there), and the
+conservative region holds a placement blind to the whole target at a configuration of H: a
+known defect, kept here as a strict expected failure until spikes are caught
+(docs/DESIGN.md, "What is and is not guaranteed").
 """
 
 from __future__ import annotations
@@ -28,33 +33,55 @@ SPIKE = (819199.67543595, 214569.40842636)
 EDGE, AT = 1, 0.8
 
 
-def _blinding_configuration(scene) -> np.ndarray:
+#: fuzz seed 201693 (G and H polygons): a placement in a spike the sweep still misses, blind
+#: to the whole target at 0.8 along the first edge of H
+SEED_MISSED, SPIKE_MISSED, EDGE_MISSED = 201693, (2.52193977, 9.74191789), 0
+
+
+def _blinding_configuration(scene, edge: int = EDGE) -> np.ndarray:
     h = np.asarray(scene.failure_geom.exterior.coords)
-    return h[EDGE] + AT * (h[EDGE + 1] - h[EDGE])
+    return h[edge] + AT * (h[edge + 1] - h[edge])
 
 
-def test_the_spike_placement_is_blind_there() -> None:
-    """The reproduction's premise, from an independent oracle (CGAL via pyvispoly): the
+@pytest.mark.parametrize(
+    ("seed", "spike", "edge"), [(SEED, SPIKE, EDGE), (SEED_MISSED, SPIKE_MISSED, EDGE_MISSED)]
+)
+def test_the_spike_placement_is_blind_there(seed, spike, edge) -> None:
+    """The reproductions' premise, from an independent oracle (CGAL via pyvispoly): the
     placement sees no point of the target at that configuration, and does see it at the
     ends of that edge of H."""
     pytest.importorskip("pyvispoly")
     from tests.oracle import VisOracle
 
-    scene = _scene(f"fuzz:{SEED}")
-    vis = VisOracle(scene).visibility(np.asarray(SPIKE))
-    q = _blinding_configuration(scene)
+    scene = _scene(f"fuzz:{seed}")
+    vis = VisOracle(scene).visibility(np.asarray(spike))
+    q = _blinding_configuration(scene, edge)
     assert shapely.intersection(vis, scene.target_at(q[0], q[1], 0.0)).area == 0.0
     h = np.asarray(scene.failure_geom.exterior.coords)
-    for end in (h[EDGE], h[EDGE + 1]):
+    for end in (h[edge], h[edge + 1]):
         assert shapely.intersection(vis, scene.target_at(end[0], end[1], 0.0)).area > 0.0
 
 
-def test_the_conservative_region_leaves_the_spike_out() -> None:
-    """``conservative=True`` stays inside the exact region here: the spike's placement is
-    not in it (it was, 10 ``tol`` deep, while the wedge rule was on)."""
-    scene = _scene(f"fuzz:{SEED}")
+@pytest.mark.parametrize(
+    ("seed", "spike"),
+    [
+        (SEED, SPIKE),
+        pytest.param(
+            SEED_MISSED,
+            SPIKE_MISSED,
+            marks=pytest.mark.xfail(
+                strict=True, reason="a spike no sample falls in (known defect, see module)"
+            ),
+        ),
+    ],
+)
+def test_the_conservative_region_leaves_the_spike_out(seed, spike) -> None:
+    """``conservative=True`` stays inside the exact region: the spike's placement is not in
+    it (on seed 202333 it was, 10 ``tol`` deep, while the wedge rule was on; on seed 201693
+    it still is)."""
+    scene = _scene(f"fuzz:{seed}")
     got = recognizable_region(scene, model="partial", theta=0.0, conservative=True)
-    assert not shapely.intersects(got, shapely.Point(SPIKE))
+    assert not shapely.intersects(got, shapely.Point(spike))
 
 
 @pytest.mark.parametrize(
