@@ -96,9 +96,9 @@ class WedgeCover:
         """Whether an event of the run ``r`` strictly inside ``life`` moves the lines of event
         ``k``'s wedge: an event of one of its corners and one of its moving anchors (the
         anchor's line passing another corner, or the tangent vertex handing over; another
-        vertex's event at the corner moves other lines).  At either corner of an event line:
-        the wedge is beyond the farther one, but the anchor's line through the nearer one
-        passing another corner moves it too (fuzz seed 201224, 5.2;
+        vertex's event at the corner moves other lines), at either corner of an event line:
+        the wedge is beyond the farther one, but a guard there alone leaves out samples whose
+        shadows reach outside the union (fuzz seeds 200177 and 201224,
         ``tests/geometry/test_sweep_wedges.py``)."""
         return _moved_at(r, k, life, {c for _, other in r.ev_ids[k] for c in other})
 
