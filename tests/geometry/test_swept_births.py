@@ -10,7 +10,8 @@ shadows) and attached to the shadows, so the birth checks do not see it either. 
 conservative region then held placements 10 ``tol`` deep that see nothing of the target at a
 configuration on the boundary of H (CGAL's visibility polygon, below).  On seed 201693 (G and
 H polygons) the sweep misses such a spike with the wedge rule off too: the other rules that
-thin the samples leave none inside its life (the previous, eager rules have one there), and the
+thin the samples leave none inside its life (the previous, eager rules have one there, and so
+does sampling both sides of every event: the one-sided events' rule left it out), and the
 conservative region holds a placement blind to the whole target at a configuration of H: a
 known defect, kept here as a strict expected failure until spikes are caught
 (docs/DESIGN.md, "What is and is not guaranteed").
