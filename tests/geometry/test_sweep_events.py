@@ -665,8 +665,7 @@ def _seen_along_g(name: str, sw: S.Sweeper, added: shapely.Geometry) -> None:
     (301 per edge; the exact point test of the sweeper ``sw`` of scene ``name``, which works
     in the scene's local frame: ``added``, in the world frame, is mapped there)."""
     scene = _scene(name)
-    fr = scene.frame
-    added = shapely.transform(added, lambda xy: (xy - [fr.ox, fr.oy]) / fr.scale)
+    added = scene.frame.geom(added)
     pts = shapely.get_coordinates(added)
     if len(pts) == 0:
         return
