@@ -110,9 +110,9 @@ def partial_region(
         ~1e-12 D snap-rounding grid of their union, see
         :func:`~geometry.sweep.swept_shadows`), so that the answer lies inside
         the exact region as long as the sweep misses no shadow deeper than ``tol``
-        (checked, not proven: a shadow *spike* that lives between two samples can be
-        missed, 4.5 ``tol`` wide on fuzz seed 201693; see docs/DESIGN.md, "What is and is
-        not guaranteed").  For a region proven inside, use
+        (checked, not proven: a shadow *spike* that lives between two samples is caught
+        only where a sample falls inside its life; see docs/DESIGN.md, "What is and is not
+        guaranteed").  For a region proven inside, use
         ``geometry.swept_bounds(...).proven_inner``.
 
     Returns

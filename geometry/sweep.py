@@ -106,12 +106,16 @@ class _Expired(Exception):
 @dataclass
 class _Cover:
     """What the traces of one edge of the region covered (:meth:`Sweeper._sweep_intervals`):
-    per line key the intervals covered (``cover``) and reached by traces (``traced``),
-    the confirmed ``(t, key)`` pairs and the cut traces already sampled after (``probed``)."""
+    per line key the intervals covered (``cover``), the intervals ``(lo, hi, edge)`` reached
+    by an edge's trace or held by an edge swept inside the known shadows (``held``: an edge
+    holds its line only while its own configuration lives, :meth:`Sweeper._continuation_gap`),
+    the intervals of edges the tracing cannot confirm (``traced``), the confirmed ``(t, key)``
+    pairs and the cut traces already sampled after (``probed``)."""
 
     cover: dict[tuple, list] = field(default_factory=dict)
     confirmed: set[tuple] = field(default_factory=set)
     traced: dict[tuple, list] = field(default_factory=dict)
+    held: dict[tuple, list] = field(default_factory=dict)
     probed: list[tuple] = field(default_factory=list)
 
 
@@ -571,21 +575,21 @@ class Sweeper(
                 for e in inside:  # swept inside the known shadows: nothing to trace
                     cover.setdefault(e[1], []).append((a, b))
                 for e in not_point:
-                    traced.setdefault(e[1], []).append((a, b))
+                    state.held.setdefault(e[1], []).append((a, b, e))
                 stats["edges"] += len(edges)
                 pieces.extend(quads)
                 for e, end in zip(edges, ends, strict=True):
                     cover.setdefault(e[1], []).append((min(t, end), max(t, end)))
                     if end != t:
                         confirmed.add((t, e[1]))
-                        traced.setdefault(e[1], []).append((min(t, end), max(t, end)))
+                        state.held.setdefault(e[1], []).append((min(t, end), max(t, end), e))
                     else:  # not confirmed even at its own sample: tracing cannot cover it
                         traced.setdefault(e[1], []).append((a, b))
                 cut += cut_short
                 confirmed.update((t, e[1]) for e in inside)
             gap = self._coverage_gap(frame(a)[1], frame(b)[1], cover, a, b, confirmed)
             if gap is None:
-                gap = self._continuation_gap(cut, traced, probed, q0, dq)
+                gap = self._continuation_gap(cut, traced, probed, q0, dq, state.held)
             if gap is not None and depth < self.max_depth:
                 stats["refined"] += 1
                 pieces.append(frame(gap)[0])

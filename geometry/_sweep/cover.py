@@ -12,6 +12,7 @@ import numpy as np
 import shapely
 
 from .._shapes import areal, snapped
+from .lines import _rot
 from .trace import _row_sweeps
 
 #: A traced edge that dies between samples while still this long relative to its length
@@ -213,12 +214,15 @@ class Coverage:
             out[k] = [e for e, n_ in zip(items[k][0], flags, strict=True) if n_]
         return out
 
-    def _continuation_gap(self, cut: list, traced: dict, probed: list, q0, dq) -> float | None:
+    def _continuation_gap(
+        self, cut: list, traced: dict, probed: list, q0, dq, held: dict | None = None
+    ) -> float | None:
         """A time just after a trace was cut short (:meth:`_cut_short_many`) at ``t_end``
-        where the cut edge's line still bounds a shadow and no trace of that line has
-        reached (nor an edge on it found swept inside the known shadows,
-        :meth:`_not_point_many`, or one that the exact point test does not confirm even at
-        its own sample: see :meth:`_coverage_gap`), or None.
+        where the cut edge's line still bounds a shadow and no edge on that line holds it
+        (``held``: per line key ``(lo, hi, edge)``, the traces and the edges swept inside the
+        known shadows, :meth:`_not_point_many`; an edge holds there where its configuration is
+        the shadow's edge on that line, below), nor has an edge the exact point test does not
+        confirm even at its own sample (``traced``: see :meth:`_coverage_gap`), or None.
 
         When a neighbouring edge dies, the edge's line goes on bounding the shadow with
         another neighbour from ``t_end`` on, and that configuration can be born and gone
@@ -235,7 +239,20 @@ class Coverage:
         time from that end longer than the probes' offset from it (``h``): the sample would
         hold no continuation to trace (``willow_south``'s 5.2 query: 6 such samples, none
         holding an edge on the cut edge's line).  Each death (``probed``: key and time,
-        within ``1e-6`` of the sweep) is looked at once."""
+        within ``1e-6`` of the sweep) is looked at once.
+
+        An edge traced or swept inside the known shadows holds its line only while its own
+        configuration (its two neighbours) lives: the continuation has a new neighbour at
+        the cut end, and where that is not the holder's, the holder says nothing of it.  So
+        a holder stands in only where it is, at the sample's time, the whole shadow edge on
+        that line with its own neighbours (:meth:`_unheld`).  Fuzz seed 201693 (5.2): the
+        edge at the later sample, swept inside, was taken to hold its line for the whole
+        interval, its neighbour there a line through two corners, while the continuation ran
+        with a line through a corner and another target vertex, born at one collinearity
+        event and gone at the next, between the samples: a shadow 4.5 ``tol`` wide was
+        missed.  Fuzz seed 202333 (with the wedge rule on): the traces from both samples
+        reached each other's, while between them the two edges' lines met on a wall, a
+        configuration neither traced (a shadow 16 ``tol`` wide)."""
         todo = []
         for edge, t_end, toward in cut:
             key = edge[1]
@@ -252,7 +269,12 @@ class Coverage:
             else:
                 free = not iv or iv[-1][1] < hi - 1e-9
             if free:
-                todo.append((edge, t_end + 0.1 * (toward - t_end)))
+                after = lo + 1e-9 if toward > t_end else hi - 1e-9
+                holders = [e for x, y, e in (held or {}).get(key, []) if x <= after <= y]
+                todo.append((edge, t_end + 0.1 * (toward - t_end), holders))
+        if not todo:
+            return None
+        todo = self._unheld(todo, q0, dq)
         if not todo:
             return None
         tp = np.array([[t] for _, t in todo])
@@ -266,6 +288,44 @@ class Coverage:
         finite = np.isfinite(d).all(axis=(1, 2))
         go = ~finite | near[: len(todo)] | near[len(todo) :]
         return float(tp[np.argmax(go), 0]) if go.any() else None
+
+    def _unheld(self, todo: list, q0, dq) -> list[tuple]:
+        """``(edge, t)`` of the items ``(edge, t, holders)`` of :meth:`_continuation_gap` that
+        no holder (an edge on the same line swept inside the known shadows) holds at time
+        ``t``: a holder holds where it is, with its own neighbours, a whole shadow edge
+        there: the exact point test confirms it (:meth:`_valid_many`) and its line does not
+        go on bounding the shadow past either end (:meth:`_runs_on`).  The holders of all
+        items in one batch."""
+        rows = [(i, h) for i, (_, _, hs) in enumerate(todo) for h in hs]
+        held_at = set()
+        if rows:
+            tp = np.array([[todo[i][1]] for i, _ in rows])
+            vs, ve = self._ends_many([h for _, h in rows], tp, q0, dq)
+            ok = self._valid_many(vs, ve, tp, q0, dq)[:, 0]
+            if ok.any():
+                k = np.flatnonzero(ok)
+                ok[k] = ~self._runs_on(vs[k, 0], ve[k, 0], q0 + tp[k] * dq)
+            held_at = {i for (i, _), v in zip(rows, ok, strict=True) if v}
+        return [(e, t) for i, (e, t, _) in enumerate(todo) if i not in held_at]
+
+    def _runs_on(self, vs: np.ndarray, ve: np.ndarray, q: np.ndarray) -> np.ndarray:
+        """(E,) bool: does the line of the shadow edge ``vs -> ve`` ((E, 2) each, the shadow
+        on its left, the target at ``q``, (E, 2)) go on bounding the shadow past an end?
+        Past the end by ``h`` along the line, the probe just inside is blind and the one just
+        outside is not (past a convex vertex of the shadow neither is blind, past a reflex
+        one both are: there the edge ends)."""
+        d = ve - vs
+        ln = np.hypot(d[:, 0], d[:, 1])
+        with np.errstate(divide="ignore", invalid="ignore"):
+            u = d / ln[:, None]
+        nrm = _rot(u) * (1e-3 * self.h)
+        past = np.stack([vs - self.h * u, ve + self.h * u], axis=1)  # (E, 2, 2)
+        inner = past + nrm[:, None, :]
+        outer = past - nrm[:, None, :]
+        qq = np.repeat(q[:, None, :], 2, axis=1)
+        blind_in = self._probes_blind(inner[..., None, :], qq)
+        blind_out = self._probes_blind(outer[..., None, :], qq)
+        return ~np.isfinite(ln) | (blind_in & ~blind_out).any(axis=1)
 
     def _line_bounds(self, lo: np.ndarray, hi: np.ndarray, ts: np.ndarray, q0, dq) -> np.ndarray:
         """(E,) bool: does some probe just outside the segments ``lo -> hi`` ((E, 1, 2) each,

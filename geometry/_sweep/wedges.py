@@ -5,8 +5,7 @@ the wedge that can open there (:mod:`.events`).  The wedge lies beyond a corner 
 between the two lines through that corner (docs/DESIGN.md, "The sides of an event where its
 wedge can be blind"), and it lies in every shadow bound of its interval; where the part of
 that cone inside the bound is already held by the two samples' shadows, the sample can add
-nothing to the union.  Part of :class:`geometry.sweep.Sweeper`.  Off (:data:`WEDGE_RULE`):
-the sample it leaves out can be the only one to catch a shadow born elsewhere in its interval.
+nothing to the union.  Part of :class:`geometry.sweep.Sweeper`; :data:`WEDGE_RULE` switches it.
 """
 
 from __future__ import annotations
@@ -16,14 +15,14 @@ import shapely
 
 from .._shapes import areal, snapped
 
-#: Whether :meth:`WedgeCover._wedge_covered` may leave samples out (off: docs/DESIGN.md,
-#: "Event samples whose wedge the samples already hold").  The rule is right about the
-#: event's wedge, but an event sample also catches what else is born in its interval, and
-#: a shadow born across an edge the tracing does not follow is caught by no other rule: on
-#: fuzz seed 202333 (mixed 5.2) leaving one such sample out put placements 10 ``tol`` deep
-#: in the conservative region that see nothing of the target at a configuration of H
-#: (``tests/geometry/test_swept_births.py``).
-WEDGE_RULE = False
+#: Whether :meth:`WedgeCover._wedge_covered` may leave samples out (docs/DESIGN.md, "Event
+#: samples whose wedge the samples already hold").  It was off for a while: on fuzz seed
+#: 202333 (mixed 5.2) a sample it left out had been the only one to catch a configuration
+#: born and gone between two samples, which the continuation rule took as held by traces of
+#: other configurations on the same line; a holder now stands in only for its own
+#: configuration (:meth:`~geometry._sweep.cover.Coverage._unheld`), and with it the rule
+#: leaves that shadow in the union (``tests/geometry/test_swept_births.py``).
+WEDGE_RULE = True
 
 #: Points on the arc of a wedge's cone (:func:`_cone`): the polygon's chords then stay
 #: within ``1 - cos(pi / 16) < 2 %`` of its radius, which is four times the scene's size.

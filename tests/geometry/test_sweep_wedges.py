@@ -21,8 +21,8 @@ from tests.geometry.test_sweep_events import _query, _scene, _seen_along_g, _wit
 
 @pytest.fixture(autouse=True)
 def _wedge_rule_on(monkeypatch) -> None:
-    """The rule is off by default (:data:`geometry._sweep.wedges.WEDGE_RULE`); these tests
-    check it as it would run."""
+    """These tests check the rule as it runs, whatever :data:`geometry._sweep.wedges.WEDGE_RULE`
+    says (it was off for a while)."""
     monkeypatch.setattr(W, "WEDGE_RULE", True)
 
 
