@@ -1,22 +1,18 @@
-"""Shadows born and gone between two samples of a sweep (docs/DESIGN.md, "What is and is not
-guaranteed"): a dense-in-time audit of the sweep's union, and the reproduction that found a
-sampling rule leaving one out.
+"""Shadows born and gone between two samples of a sweep (docs/DESIGN.md, "Held edges hold their
+own configuration only" and "What is and is not guaranteed"): a dense-in-time audit of the
+sweep's union, and the two reproductions of a continuation the sweep missed.
 
-On fuzz seed 202333 (contact family; G a point, H a polygon: the mixed 5.2 query) the umbra of
-a small obstacle pokes out of the other shadows for about a sixth of one edge of H, a spike born
-across an edge that the tracing does not follow (its sweep stays inside the two samples'
-shadows) and attached to the shadows, so the birth checks do not see it either.  The wedge rule
-(:mod:`geometry._sweep.wedges`) left out the event sample that had caught it, and the
-conservative region then held placements 10 ``tol`` deep that see nothing of the target at a
-configuration on the boundary of H (CGAL's visibility polygon, below).  On seed 201693 (G and
-H polygons) the sweep missed a shadow 4.5 ``tol`` wide with the wedge rule off too: a traced
-edge was cut short when its neighbour died, and its continuation (the same line with a new
-neighbour, born at one collinearity event and gone at the next, between the samples) was taken
-as held by the edge on that line at the later sample, swept inside the known shadows, though
-that edge's own neighbour was another line; the conservative region held a placement blind to
-the whole target at a configuration of H.  A held edge now stands in for a continuation only
-where it is, at the continuation's time, a whole shadow edge with its own neighbours
-(:meth:`geometry._sweep.cover.Coverage._unheld`).
+A traced edge is cut short when a neighbour dies, and its line goes on bounding the shadow with
+a new neighbour; that configuration can be born and gone between two samples, and the
+continuation rule samples it unless an edge on the line holds it.  On fuzz seed 202333 (contact
+family; G a point, H a polygon: the mixed 5.2 query; with the wedge rule on) the traces of two
+neighbouring edges from both samples reached each other's while in between their lines met on a
+wall; on seed 201693 (G and H polygons) the edge on the line at the later sample, swept inside
+the known shadows, had another neighbour than the continuation.  Both were taken as holding the
+line, and the conservative region held placements that see nothing of the target at a
+configuration on the boundary of H (CGAL's visibility polygon, below).  A holder now stands in
+only where it is, at the continuation's time, the whole shadow edge on that line with its own
+neighbours (:meth:`geometry._sweep.cover.Coverage._unheld`).
 """
 
 from __future__ import annotations
@@ -29,7 +25,7 @@ from benchmarks.sweep_audit import widest_miss
 from geometry import recognizable_region
 from tests.geometry.test_sweep_events import _scene
 
-#: fuzz seed 202333: a placement (world frame) inside the spike, and the configuration on the
+#: fuzz seed 202333: a placement (world frame) in the missed shadow, and the configuration on the
 #: boundary of H (the point at 0.8 of its second edge) where it sees nothing of the target
 SEED = 202333
 SPIKE = (819199.67543595, 214569.40842636)
