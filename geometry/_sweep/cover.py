@@ -215,7 +215,7 @@ class Coverage:
         return out
 
     def _continuation_gap(
-        self, cut: list, traced: dict, probed: list, q0, dq, held: dict | None = None
+        self, cut: list, traced: dict, probed: list, q0, dq, held: dict
     ) -> float | None:
         """A time just after a trace was cut short (:meth:`_cut_short_many`) at ``t_end``
         where the cut edge's line still bounds a shadow and no edge on that line holds it
@@ -270,7 +270,7 @@ class Coverage:
                 free = not iv or iv[-1][1] < hi - 1e-9
             if free:
                 after = lo + 1e-9 if toward > t_end else hi - 1e-9
-                holders = [e for x, y, e in (held or {}).get(key, []) if x <= after <= y]
+                holders = [e for x, y, e in held.get(key, []) if x <= after <= y]
                 todo.append((edge, t_end + 0.1 * (toward - t_end), holders))
         if not todo:
             return None
@@ -291,7 +291,7 @@ class Coverage:
 
     def _unheld(self, todo: list, q0, dq) -> list[tuple]:
         """``(edge, t)`` of the items ``(edge, t, holders)`` of :meth:`_continuation_gap` that
-        no holder (an edge on the same line swept inside the known shadows) holds at time
+        no holder (an edge on the same line, traced or swept inside the known shadows) holds at time
         ``t``: a holder holds where it is, with its own neighbours, a whole shadow edge
         there: the exact point test confirms it (:meth:`_valid_many`) and its line does not
         go on bounding the shadow past either end (:meth:`_runs_on`).  The holders of all
@@ -320,12 +320,9 @@ class Coverage:
             u = d / ln[:, None]
         nrm = _rot(u) * (1e-3 * self.h)
         past = np.stack([vs - self.h * u, ve + self.h * u], axis=1)  # (E, 2, 2)
-        inner = past + nrm[:, None, :]
-        outer = past - nrm[:, None, :]
-        qq = np.repeat(q[:, None, :], 2, axis=1)
-        blind_in = self._probes_blind(inner[..., None, :], qq)
-        blind_out = self._probes_blind(outer[..., None, :], qq)
-        return ~np.isfinite(ln) | (blind_in & ~blind_out).any(axis=1)
+        probes = np.stack([past + nrm[:, None, :], past - nrm[:, None, :]], axis=1)  # in, out
+        blind = self._probes_blind(probes[..., None, :], q[:, None, None, :])
+        return ~np.isfinite(ln) | (blind[:, 0] & ~blind[:, 1]).any(axis=1)
 
     def _line_bounds(self, lo: np.ndarray, hi: np.ndarray, ts: np.ndarray, q0, dq) -> np.ndarray:
         """(E,) bool: does some probe just outside the segments ``lo -> hi`` ((E, 1, 2) each,
